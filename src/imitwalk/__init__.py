@@ -1,0 +1,29 @@
+"""imitwalk: a humanoid robot learns to walk by imitating human motion capture.
+
+An implementation, and extension, of Chalodhorn, Grimes, Grochow & Rao,
+*Learning to Walk through Imitation*, IJCAI 2007, on a HOAP-2-class humanoid
+simulated in MuJoCo.
+"""
+
+from __future__ import annotations
+
+from imitwalk.errors import (
+    ConfigError,
+    ImitwalkError,
+    MocapError,
+    RetargetError,
+    RobotError,
+    RunError,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ConfigError",
+    "ImitwalkError",
+    "MocapError",
+    "RetargetError",
+    "RobotError",
+    "RunError",
+    "__version__",
+]

@@ -1,0 +1,108 @@
+"""Walking metrics from a :class:`~imitwalk.sim.Rollout` (pure NumPy).
+
+These read the simulator's ground-truth torso pose, so they are for *judging* a
+run only; nothing here is ever fed back to a learner.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+__all__ = ["WalkMetrics", "summarise", "tilt_deg", "walk_metrics", "yaw_rad"]
+
+
+def tilt_deg(quat: np.ndarray) -> np.ndarray:
+    """Angle between the body z axis and world z [deg] for ``(N, 4)`` (w, x, y, z) quaternions."""
+    q = np.atleast_2d(quat)
+    czz = 1.0 - 2.0 * (q[:, 1] ** 2 + q[:, 2] ** 2)
+    return np.degrees(np.arccos(np.clip(czz, -1.0, 1.0)))
+
+
+def yaw_rad(quat: np.ndarray) -> np.ndarray:
+    """Heading of the body x axis about world z [rad], unwrapped, for ``(N, 4)`` quaternions."""
+    q = np.atleast_2d(quat)
+    w, x, y, z = q.T
+    return np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+
+
+@dataclass(frozen=True)
+class WalkMetrics:
+    """How one run walked.
+
+    Attributes:
+        fell: the torso fell; fall_time_s: when [s] (``None`` if it did not).
+        seconds: simulated time [s].
+        forward_distance_m: torso travel along the initial heading [m].
+        forward_speed_mps: that distance over the time walked [m/s].
+        progress_ratio: forward distance ÷ the distance the reference commands over
+            the same time (stride per cycle × cycles executed).
+        lateral_drift_m: sideways torso travel [m]; yaw_drift_deg: heading change [deg].
+        gyro_rms: RMS of the torso angular velocity norm [rad/s].
+        max_tilt_deg: largest torso tilt [deg].
+        joint_rms_error_rad: RMS of measured minus reference joint angles [rad].
+    """
+
+    fell: bool
+    fall_time_s: float | None
+    seconds: float
+    forward_distance_m: float
+    forward_speed_mps: float
+    progress_ratio: float
+    lateral_drift_m: float
+    yaw_drift_deg: float
+    gyro_rms: float
+    max_tilt_deg: float
+    joint_rms_error_rad: float
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        return asdict(self)
+
+
+def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = None) -> WalkMetrics:
+    """Judge a rollout.
+
+    Args:
+        rollout: a :class:`~imitwalk.sim.Rollout`.
+        expected_distance: distance the reference commands over the rollout's
+            duration [m] (the denominator of ``progress_ratio``).
+        q_ref: ``(N, n)`` reference joint angles to compare the measured ones with;
+            defaults to the commanded targets.
+    """
+    pos, quat = rollout.torso_pos, rollout.torso_quat
+    if len(pos) == 0:
+        raise ValueError("empty rollout")
+    yaw = yaw_rad(quat)
+    head = yaw[0]
+    d = pos[-1, :2] - pos[0, :2]
+    fwd = float(d[0] * np.cos(head) + d[1] * np.sin(head))
+    lat = float(-d[0] * np.sin(head) + d[1] * np.cos(head))
+    tail = max(1, int(round(1.0 / rollout.control_dt)))
+    yaw_drift = float(np.degrees(np.mean(yaw[-tail:]) - head))
+    seconds = rollout.seconds
+    ref = rollout.q_cmd if q_ref is None else q_ref[: len(rollout.q)]
+    err = rollout.q - ref
+    return WalkMetrics(
+        fell=bool(rollout.fell),
+        fall_time_s=rollout.fall_time,
+        seconds=float(seconds),
+        forward_distance_m=fwd,
+        forward_speed_mps=fwd / seconds if seconds > 0 else 0.0,
+        progress_ratio=fwd / expected_distance if expected_distance > 0 else 0.0,
+        lateral_drift_m=lat,
+        yaw_drift_deg=yaw_drift,
+        gyro_rms=float(np.sqrt(np.mean(np.sum(rollout.gyro**2, axis=1)))),
+        max_tilt_deg=float(tilt_deg(quat).max()),
+        joint_rms_error_rad=float(np.sqrt(np.mean(err**2))),
+    )
+
+
+def summarise(values: Sequence[float]) -> dict:
+    """``{"mean", "min", "max"}`` of per-seed figures (NaN-free floats)."""
+    a = np.asarray([v for v in values if v is not None], dtype=float)
+    if a.size == 0:
+        return {"mean": None, "min": None, "max": None}
+    return {"mean": float(a.mean()), "min": float(a.min()), "max": float(a.max())}

@@ -1,0 +1,336 @@
+"""The simulator layer: the only module that steps physics.
+
+:class:`Plant` is the interface a real robot driver could also implement: reset to
+a posture, command joint targets, step one control period, read an
+:class:`Observation` (what the robot's own sensors measure). :class:`MujocoPlant`
+implements it on MuJoCo with position servos commanded at ``control_hz`` while the
+physics runs at ``physics_hz``. :func:`run` closes a loop around any policy and
+returns a typed :class:`Rollout`; :func:`playback` plays a joint trajectory.
+
+Robustness options (all default off) live in :class:`SimOptions`: gyro and
+accelerometer noise (added in NumPy, MuJoCo does not simulate sensor noise), servo
+delay, friction / mass / servo-stiffness scaling and per-part jitter, a ground
+slope (gravity tilted about y), a timed push on the torso and an initial twist.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import mujoco
+import numpy as np
+
+from imitwalk.robots import Robot
+
+__all__ = ["MujocoPlant", "Observation", "Plant", "Rollout", "SimOptions", "playback", "run"]
+
+
+@dataclass(frozen=True)
+class SimOptions:
+    """Simulation settings. Every perturbation defaults to off.
+
+    Attributes:
+        physics_hz: physics rate [Hz] (HOAP-2's servo loop runs at 1 kHz).
+        control_hz: rate at which joint targets are commanded [Hz].
+        gyro_noise: gyro noise standard deviation [rad/s].
+        accel_noise: accelerometer noise standard deviation [m/s²].
+        servo_delay: commands reach the servos this many control periods late.
+        friction: if set, the sliding friction coefficient of every contact.
+        friction_scale: multiplies every sliding friction coefficient.
+        mass_scale: multiplies every body mass and inertia.
+        mass_jitter: each body's mass also scaled by U(1 - j, 1 + j) (drawn from ``seed``).
+        kp_scale: multiplies every servo stiffness; kp_jitter: per servo U(1 - j, 1 + j).
+        slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
+        push_time, push_duration: when [s] and how long [s] the torso is pushed.
+        push_force: ``(3,)`` world-frame force on the torso during the push [N].
+        init_twist: ``(6,)`` initial base velocity, linear [m/s] then angular [rad/s].
+        seed: seeds sensor noise and jitter.
+        fall_height: a fall is the torso under this fraction of its standing height ...
+        fall_tilt_deg: ... or the torso tilted more than this [deg].
+    """
+
+    physics_hz: float = 1000.0
+    control_hz: float = 100.0
+    gyro_noise: float = 0.0
+    accel_noise: float = 0.0
+    servo_delay: int = 0
+    friction: float | None = None
+    friction_scale: float = 1.0
+    mass_scale: float = 1.0
+    mass_jitter: float = 0.0
+    kp_scale: float = 1.0
+    kp_jitter: float = 0.0
+    slope_deg: float = 0.0
+    push_time: float = 0.0
+    push_duration: float = 0.0
+    push_force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    init_twist: tuple[float, ...] = (0.0,) * 6
+    seed: int = 0
+    fall_height: float = 0.5
+    fall_tilt_deg: float = 45.0
+
+    @property
+    def substeps(self) -> int:
+        """Physics steps per control period."""
+        return max(1, round(self.physics_hz / self.control_hz))
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the robot measures at one control tick.
+
+    Attributes:
+        t: time [s]; gyro: ``(3,)`` torso angular velocity [rad/s], torso frame;
+        accel: ``(3,)`` torso specific force [m/s²]; foot_force: ``(2, k)`` normal
+        force per sole sensor [N], left row then right; joints: ``(n,)`` angles [rad].
+    """
+
+    t: float
+    gyro: np.ndarray
+    accel: np.ndarray
+    foot_force: np.ndarray
+    joints: np.ndarray
+
+
+@runtime_checkable
+class Plant(Protocol):
+    """A robot that takes joint targets at a fixed control period and reports sensors."""
+
+    joint_names: tuple[str, ...]
+    control_dt: float
+
+    def reset(self, q: np.ndarray | None = None) -> Observation:
+        """Put the robot in posture ``q`` (``(n,)`` rad; ``None``: standing) and hold it."""
+        ...
+
+    def command(self, targets: np.ndarray) -> None:
+        """Set ``(n,)`` joint targets [rad] for the next control period."""
+        ...
+
+    def step(self) -> Observation:
+        """Advance one control period and return the new observation."""
+        ...
+
+
+@dataclass
+class Rollout:
+    """Everything recorded at each control tick of a run (``N`` ticks).
+
+    ``t`` (N,) [s]; ``q_cmd``/``q`` (N, n) commanded/measured joints [rad];
+    ``gyro``/``accel`` (N, 3); ``foot_force`` (N, 2, k) [N]; ``torso_pos`` (N, 3) [m]
+    and ``torso_quat`` (N, 4) (w, x, y, z) are simulator ground truth, for metrics
+    only; ``qpos`` (N, nq) for rendering. ``fell``/``fall_time`` [s] say whether and
+    when the torso fell; ``control_dt`` [s]; ``info`` holds per-run extras.
+    """
+
+    t: np.ndarray
+    q_cmd: np.ndarray
+    q: np.ndarray
+    gyro: np.ndarray
+    accel: np.ndarray
+    foot_force: np.ndarray
+    torso_pos: np.ndarray
+    torso_quat: np.ndarray
+    qpos: np.ndarray
+    fell: bool
+    fall_time: float | None
+    control_dt: float
+    joint_names: tuple[str, ...] = ()
+    info: dict = field(default_factory=dict)
+
+    @property
+    def seconds(self) -> float:
+        """Simulated time covered [s]."""
+        return len(self.t) * self.control_dt
+
+
+class MujocoPlant:
+    """:class:`Plant` on MuJoCo. Builds its own (perturbed) model from ``robot``."""
+
+    def __init__(self, robot: Robot, options: SimOptions | None = None):
+        self.robot = robot
+        self.options = opt = options or SimOptions()
+        self.joint_names = robot.joint_names
+        self.control_dt = opt.substeps / opt.physics_hz
+        self.model = m = robot.compile()
+        rng = np.random.default_rng(opt.seed)
+        m.opt.timestep = 1.0 / opt.physics_hz
+        th = np.deg2rad(opt.slope_deg)
+        m.opt.gravity[:] = 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+        if opt.friction is not None:
+            m.geom_friction[:, 0] = opt.friction
+        m.geom_friction[:, 0] *= opt.friction_scale
+        scale = opt.mass_scale * rng.uniform(1 - opt.mass_jitter, 1 + opt.mass_jitter, m.nbody)
+        scale[0] = 1.0
+        m.body_mass[:] *= scale
+        m.body_inertia[:] *= scale[:, None]
+        self._jid = np.array([m.joint(j).id for j in robot.mj_joints])
+        self._qadr = m.jnt_qposadr[self._jid]
+        act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
+        self._act = np.array([act_for[j] for j in self._jid])
+        kps = opt.kp_scale * rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(self._act))
+        m.actuator_gainprm[self._act, 0] *= kps
+        m.actuator_biasprm[self._act, 1] *= kps
+        self._sign = robot.signs
+
+        def sadr(name: str) -> slice:
+            sid = m.sensor(name).id
+            return slice(m.sensor_adr[sid], m.sensor_adr[sid] + m.sensor_dim[sid])
+
+        self._gyro = sadr(robot.gyro)
+        self._accel = sadr(robot.accelerometer) if robot.accelerometer else None
+        self._ff = [[sadr(n) for n in robot.foot_force[s]] for s in ("l", "r")]
+        self._torso = m.body(robot.torso).id
+        self._noise = np.random.default_rng(opt.seed + 7919)
+        self.data = mujoco.MjData(m)
+        self._queue: deque[np.ndarray] = deque()
+        self._cmd = robot.stand.copy()
+        self.fell = False
+        self.fall_time: float | None = None
+
+    # -- Plant interface ------------------------------------------------------
+    def reset(self, q: np.ndarray | None = None) -> Observation:
+        m, d, r = self.model, self.data, self.robot
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] = r.stand_qpos
+        if q is not None:
+            q = np.asarray(q, dtype=float)
+            d.qpos[self._qadr] = q * self._sign
+            mujoco.mj_kinematics(m, d)
+            low = min(self._sole_z(s) for s in ("l", "r"))
+            d.qpos[2] -= low - 1e-4
+        d.qvel[:6] = self.options.init_twist
+        self._cmd = (r.stand if q is None else q).copy()
+        self._queue = deque([self._cmd.copy()] * self.options.servo_delay)
+        d.ctrl[self._act] = self._cmd * self._sign
+        mujoco.mj_forward(m, d)
+        self.fell, self.fall_time = False, None
+        return self.observe()
+
+    def command(self, targets: np.ndarray) -> None:
+        targets = np.asarray(targets, dtype=float)
+        if targets.shape != (len(self.joint_names),):
+            raise ValueError(f"expected {len(self.joint_names)} joint targets, got {targets.shape}")
+        self._cmd = self.robot.clip(targets)
+
+    def step(self) -> Observation:
+        m, d, opt = self.model, self.data, self.options
+        self._queue.append(self._cmd)
+        applied = self._queue.popleft()
+        d.ctrl[self._act] = applied * self._sign
+        for _ in range(opt.substeps):
+            t0 = opt.push_time
+            on = opt.push_duration > 0 and t0 <= d.time < t0 + opt.push_duration
+            d.xfrc_applied[self._torso, :3] = opt.push_force if on else 0.0
+            mujoco.mj_step(m, d)
+        self._check_fall()
+        return self.observe()
+
+    # -- extras (not part of Plant) -------------------------------------------
+    def observe(self) -> Observation:
+        """Sensor readings now, with the configured noise."""
+        d, opt = self.data, self.options
+        gyro = d.sensordata[self._gyro].copy()
+        accel = d.sensordata[self._accel].copy() if self._accel else np.zeros(3)
+        if opt.gyro_noise:
+            gyro += self._noise.normal(0.0, opt.gyro_noise, 3)
+        if opt.accel_noise:
+            accel += self._noise.normal(0.0, opt.accel_noise, 3)
+        ff = np.array([[d.sensordata[s][0] for s in side] for side in self._ff])
+        return Observation(d.time, gyro, accel, ff, d.qpos[self._qadr] * self._sign)
+
+    def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Ground truth torso position ``(3,)`` [m] and quaternion ``(4,)`` (w, x, y, z)."""
+        return self.data.xpos[self._torso].copy(), self.data.xquat[self._torso].copy()
+
+    def _sole_z(self, side: str) -> float:
+        name = self.robot.soles[side]
+        if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
+            return float(self.data.site_xpos[self.model.site(name).id][2])
+        return float(self.data.xpos[self.model.body(name).id][2])
+
+    def _check_fall(self) -> None:
+        if self.fell:
+            return
+        d, opt = self.data, self.options
+        low = d.xpos[self._torso][2] < opt.fall_height * self.robot.torso_height
+        tilt = np.degrees(np.arccos(np.clip(d.xmat[self._torso][8], -1.0, 1.0)))
+        if low or tilt > opt.fall_tilt_deg:
+            self.fell, self.fall_time = True, float(d.time)
+
+
+Policy = Callable[[int, Observation], np.ndarray]
+
+
+def run(
+    plant: MujocoPlant,
+    policy: Policy,
+    steps: int,
+    q0: np.ndarray | None = None,
+    stop_on_fall: bool = True,
+) -> Rollout:
+    """Run ``policy(tick, obs) -> (n,) targets`` for ``steps`` control periods.
+
+    Args:
+        plant: the simulated robot (reset here to ``q0``, standing if ``None``).
+        policy: called once per tick with the tick index and the latest observation.
+        steps: number of control periods to run.
+        stop_on_fall: end the run at the first fall.
+    """
+    obs = plant.reset(q0)
+    n, nq = len(plant.joint_names), plant.model.nq
+    rec = {k: [] for k in ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos")}
+    for k in range(steps):
+        target = np.asarray(policy(k, obs), dtype=float)
+        plant.command(target)
+        obs = plant.step()
+        pos, quat = plant.torso_pose()
+        for key, val in zip(
+            rec,
+            (
+                obs.t,
+                plant._cmd,
+                obs.joints,
+                obs.gyro,
+                obs.accel,
+                obs.foot_force,
+                pos,
+                quat,
+                plant.data.qpos.copy(),
+            ),
+            strict=True,
+        ):
+            rec[key].append(val)
+        if plant.fell and stop_on_fall:
+            break
+    arr = {k: np.asarray(v) for k, v in rec.items()}
+    empty = len(arr["t"]) == 0
+    return Rollout(
+        t=arr["t"],
+        q_cmd=arr["q_cmd"].reshape(-1, n),
+        q=arr["q"].reshape(-1, n),
+        gyro=arr["gyro"].reshape(-1, 3),
+        accel=arr["accel"].reshape(-1, 3),
+        foot_force=arr["ff"] if not empty else np.zeros((0, 2, 0)),
+        torso_pos=arr["pos"].reshape(-1, 3),
+        torso_quat=arr["quat"].reshape(-1, 4),
+        qpos=arr["qpos"].reshape(-1, nq),
+        fell=plant.fell,
+        fall_time=plant.fall_time,
+        control_dt=plant.control_dt,
+        joint_names=plant.joint_names,
+    )
+
+
+def playback(
+    plant: MujocoPlant,
+    targets: np.ndarray,
+    q0: np.ndarray | None = None,
+    stop_on_fall: bool = True,
+) -> Rollout:
+    """Play ``(N, n)`` joint targets, one row per control period, open loop."""
+    targets = np.asarray(targets, dtype=float)
+    return run(plant, lambda k, _obs: targets[k], len(targets), q0=q0, stop_on_fall=stop_on_fall)
