@@ -1,0 +1,257 @@
+"""C3D reader (Vicon Plug-in-Gait marker set), via the ``c3d`` package.
+
+Keypoints, in the file's lab axes (z-up; y-up labs are mapped by (x, y, z) -> (x, -z, y)):
+
+* Plug-in-Gait model outputs, when the file has them (preferred): ``pelvis = PELO``
+  (mid-point of the hip centres), hips ``LFEP/RFEP`` (femur proximal point = hip
+  centre), knees ``LFEO/RFEO``, ankles ``LTIO/RTIO``.
+* otherwise from markers: hip centres by the Harrington et al. (2007, J Biomech 40:595)
+  regression in the pelvis frame (origin mid-ASIS, x anterior, y up, z right; PW =
+  inter-ASIS width, PD = mid-ASIS to mid-PSIS (or SACR) depth, mm)::
+
+      x = -0.24 PD - 9.9,  y = -0.30 PW - 10.9,  z = +-(0.33 PW + 7.3)
+
+  knees / ankles at the mid-point of the lateral and medial markers, or without a medial
+  marker by the Plug-in-Gait chord rule: the centre C lies half the joint width plus a
+  marker radius medial of the lateral marker J, in the plane of J, the wand marker (THI,
+  TIB) and the proximal centre P, with P-C perpendicular to J-C. Joint widths come from
+  ``PROCESSING:{L,R}{KNEE,ANKLE}WIDTH`` [mm] (defaults 100 / 70 mm, marker 14 mm).
+* toes: ``LTOE/RTOE``; optional: neck = mid(C7, CLAV), head = centroid of LFHD RFHD LBHD
+  RBHD, shoulders LSHO, elbows LELB, wrists mid(LWRA, LWRB).
+
+Invalid samples (negative residual or all-zero) are NaN; gaps up to ``max_gap`` [s] are
+filled (:func:`imitwalk.mocap.gaps.fill_gaps`) and noted in ``Motion.filled``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import c3d
+import numpy as np
+
+from imitwalk.errors import MocapError, unknown_name
+from imitwalk.mocap._common import check_keypoints, snap_rate, up_axis, z_up
+from imitwalk.mocap.gaps import GapTooLong, fill_gaps
+from imitwalk.mocap.motion import KEYPOINTS, LOWER_BODY, Motion
+
+__all__ = ["MARKER_ALIASES", "POINT_UNITS", "read_c3d"]
+
+#: POINT:UNITS -> metres per unit.
+POINT_UNITS = {"mm": 0.001, "cm": 0.01, "m": 1.0}
+
+#: Plug-in-Gait role (left side; right is the same with "R") -> accepted labels.
+MARKER_ALIASES: dict[str, tuple[str, ...]] = {
+    "ASI": ("ASI", "ASIS", "FWT"),  # FWT/BWT: front/back waist of the CMU 41-marker set
+    "PSI": ("PSI", "PSIS", "BWT"),
+    "THI": ("THI", "LTHI"),
+    "KNE": ("KNE", "LEK", "KNEE", "LFE"),
+    "KNM": ("KNM", "MEK", "MKNE", "MFE", "KNEM"),
+    "TIB": ("TIB", "LSHA", "SHA", "SHN"),
+    "ANK": ("ANK", "LM", "LMAL", "ANKLE"),
+    "MED": ("MED", "MM", "MMAL", "ANKM"),
+    "TOE": ("TOE", "MT2", "TOE2"),
+    "SHO": ("SHO",),
+    "ELB": ("ELB",),
+    "WRA": ("WRA",),
+    "WRB": ("WRB",),
+    "FHD": ("FHD",),
+    "BHD": ("BHD",),
+}
+_CENTRAL = {"SACR": ("SACR", "SACRUM"), "C7": ("C7",), "CLAV": ("CLAV", "JN", "IJ")}
+_PIG = ("PELO", "LFEP", "RFEP", "LFEO", "RFEO", "LTIO", "RTIO")
+_MARKER_RADIUS_MM = 7.0
+
+
+def _chord(joint: np.ndarray, wand: np.ndarray, prox: np.ndarray, offset: float) -> np.ndarray:
+    """Joint centre ``offset`` medial of the lateral marker ``joint`` (all ``(T, 3)``)."""
+    a = prox - joint
+    length = np.linalg.norm(a, axis=1, keepdims=True)
+    a = a / length
+    w = wand - joint
+    w = w - np.sum(w * a, axis=1, keepdims=True) * a
+    medial = -w / np.linalg.norm(w, axis=1, keepdims=True)
+    cos = np.clip(offset / length, -1.0, 1.0)
+    return joint + offset * (cos * a + np.sqrt(1.0 - cos**2) * medial)
+
+
+def _hip_centres(lasi, rasi, back) -> tuple[np.ndarray, np.ndarray]:
+    """Harrington (2007) hip centres [mm] from ASIS markers and mid-PSIS/SACR (``(T, 3)``)."""
+    origin = (lasi + rasi) / 2
+    z = rasi - lasi
+    pw = np.linalg.norm(z, axis=1, keepdims=True)
+    z = z / pw
+    x = origin - back
+    pd = np.linalg.norm(x, axis=1, keepdims=True)
+    x = x - np.sum(x * z, axis=1, keepdims=True) * z
+    x = x / np.linalg.norm(x, axis=1, keepdims=True)
+    y = np.cross(z, x)
+    out = []
+    for sign in (-1.0, 1.0):  # left, right
+        loc = (-0.24 * pd - 9.9, -0.30 * pw - 10.9, sign * (0.33 * pw + 7.3))
+        out.append(origin + loc[0] * x + loc[1] * y + loc[2] * z)
+    return out[0], out[1]
+
+
+def _read(path: str | Path) -> tuple[c3d.Reader, np.ndarray, list[str]]:
+    p = Path(path)
+    if not p.is_file():
+        raise MocapError(f"mocap file not found: {p}")
+    try:
+        with p.open("rb") as handle, warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="No analog data", category=UserWarning)
+            reader = c3d.Reader(handle)
+            frames = [pts[:, :4].copy() for _, pts, _ in reader.read_frames(copy=True)]
+    except Exception as exc:  # the c3d package raises bare ValueError/struct.error/...
+        raise MocapError(f"{p}: not a readable C3D file: {exc}".replace("\n", " ")) from None
+    if not frames:
+        raise MocapError(f"{p}: C3D file has no frames")
+    pts = np.array(frames, dtype=float)  # (T, N, 4): x, y, z, residual
+    bad = (pts[:, :, 3] < 0) | np.all(pts[:, :, :3] == 0, axis=2)
+    xyz = np.where(bad[:, :, None], np.nan, pts[:, :, :3])
+    labels = [str(s).strip() for s in reader.point_labels]
+    return reader, xyz, labels
+
+
+def _param(reader: c3d.Reader, key: str, default: float) -> float:
+    p = reader.get(key)
+    return float(p.float_value) if p is not None and p.total_bytes >= 4 else default
+
+
+def _events(reader: c3d.Reader, fps: float) -> list[tuple[str, str, float, int]]:
+    """(context, label, time [s], frame index) of each C3D event, by time."""
+    group = reader.get("EVENT")
+    if group is None or group.get("TIMES") is None or group.get("LABELS") is None:
+        return []
+    times = np.asarray(group.get("TIMES").float_array, dtype=float).reshape(-1, 2)
+    labels = [s.strip() for s in np.atleast_1d(group.get("LABELS").string_array)]
+    ctx_p = group.get("CONTEXTS")
+    contexts = (
+        [s.strip() for s in np.atleast_1d(ctx_p.string_array)] if ctx_p else [""] * len(labels)
+    )
+    out = []
+    for (minutes, seconds), label, ctx in zip(times, labels, contexts, strict=False):
+        t = 60.0 * minutes + seconds
+        out.append((ctx, label, float(t), int(round(t * fps)) + 1 - int(reader.first_frame)))
+    return sorted(out, key=lambda e: e[2])
+
+
+def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool = True) -> Motion:
+    """Read a C3D trial.
+
+    Args:
+        path: the ``.c3d`` file.
+        max_gap: longest gap [s] of a marker that is filled by interpolation.
+        use_model_outputs: use Plug-in-Gait joint centres when the file has them.
+
+    Returns:
+        a :class:`Motion`: ``data`` ``(T, 3 N)`` every POINT label (markers and model
+        outputs) in the file's units, NaN where invalid; ``keypoints`` ``(T, 3)`` [m] z
+        up; ``meta``: ``units``, ``hip_method``, ``missing_keypoints``, ``events``
+        (context, label, time [s], frame index), ``first_frame``.
+    """
+    src = str(path)
+    reader, xyz, labels = _read(path)
+    fps = snap_rate(float(reader.point_rate))
+    units = (
+        str(reader.get("POINT:UNITS").string_value).strip().lower()
+        if reader.get("POINT:UNITS")
+        else "mm"
+    )
+    if units not in POINT_UNITS:
+        raise unknown_name("C3D POINT:UNITS", units, POINT_UNITS, MocapError)
+    to_mm = POINT_UNITS[units] * 1000.0
+    # lookup by upper-case label without a "Subject:" prefix; the first of duplicates wins
+    index = {lab.rsplit(":", 1)[-1].upper(): i for i, lab in reversed(list(enumerate(labels)))}
+    max_frames = int(round(max_gap * fps))
+    filled: list[str] = []
+    cache: dict[str, np.ndarray] = {}
+
+    def marker(role: str) -> np.ndarray:
+        """Filled ``(T, 3)`` trajectory [mm] of a role such as ``LKNE`` or ``C7``."""
+        if role not in cache:
+            if role in _CENTRAL:
+                names = _CENTRAL[role]
+            elif role[1:] in MARKER_ALIASES:
+                names = tuple(role[0] + a for a in MARKER_ALIASES[role[1:]])
+            else:
+                names = (role,)
+            label = next((n for n in names if n in index), None)
+            if label is None:
+                raise MocapError(
+                    f"{src}: required marker {role} not found (tried {', '.join(names)})"
+                )
+            try:
+                cache[role], notes = fill_gaps(xyz[:, index[label]] * to_mm, max_frames, label, fps)
+            except GapTooLong as exc:
+                raise GapTooLong(f"{src}: {exc}") from None
+            filled.extend(notes)
+        return cache[role]
+
+    def has(role: str) -> bool:
+        try:
+            marker(role)
+        except MocapError:
+            return False
+        return True
+
+    kp: dict[str, np.ndarray] = {}
+    use_pig = use_model_outputs and all(p in index for p in _PIG)
+    if use_pig:
+        kp["pelvis"] = marker("PELO")
+        for s in "LR":
+            kp[f"{s.lower()}_hip"], kp[f"{s.lower()}_knee"] = marker(f"{s}FEP"), marker(f"{s}FEO")
+            kp[f"{s.lower()}_ankle"] = marker(f"{s}TIO")
+    else:
+        back = marker("SACR") if has("SACR") else (marker("LPSI") + marker("RPSI")) / 2
+        kp["l_hip"], kp["r_hip"] = _hip_centres(marker("LASI"), marker("RASI"), back)
+        kp["pelvis"] = (kp["l_hip"] + kp["r_hip"]) / 2
+        for s in "LR":
+            k = s.lower()
+            knee_off = _param(reader, f"PROCESSING:{s}KNEEWIDTH", 100.0) / 2 + _MARKER_RADIUS_MM
+            ankle_off = _param(reader, f"PROCESSING:{s}ANKLEWIDTH", 70.0) / 2 + _MARKER_RADIUS_MM
+            lat = marker(f"{s}KNE")
+            kp[f"{k}_knee"] = (
+                (lat + marker(f"{s}KNM")) / 2
+                if has(f"{s}KNM")
+                else _chord(lat, marker(f"{s}THI"), kp[f"{k}_hip"], knee_off)
+            )
+            lat = marker(f"{s}ANK")
+            kp[f"{k}_ankle"] = (
+                (lat + marker(f"{s}MED")) / 2
+                if has(f"{s}MED")
+                else _chord(lat, marker(f"{s}TIB"), kp[f"{k}_knee"], ankle_off)
+            )
+    kp["l_toe"], kp["r_toe"] = marker("LTOE"), marker("RTOE")
+    optional: dict[str, Callable[[], np.ndarray]] = {
+        "neck": lambda: (marker("C7") + marker("CLAV")) / 2,
+        "head": lambda: sum(marker(m) for m in ("LFHD", "RFHD", "LBHD", "RBHD")) / 4,
+    }
+    for s in "LR":
+        optional[f"{s.lower()}_shoulder"] = lambda s=s: marker(f"{s}SHO")
+        optional[f"{s.lower()}_elbow"] = lambda s=s: marker(f"{s}ELB")
+        optional[f"{s.lower()}_wrist"] = lambda s=s: (marker(f"{s}WRA") + marker(f"{s}WRB")) / 2
+    missing = []
+    for key, make in optional.items():
+        try:
+            kp[key] = make()
+        except MocapError:
+            missing.append(key)
+    hips_to_ankles = np.nanmean(kp["l_ankle"] - kp["l_hip"], axis=0)
+    up = up_axis(hips_to_ankles, src)
+    keypoints = check_keypoints(
+        {k: z_up(kp[k] / 1000.0, up) for k in KEYPOINTS if k in kp}, src, len(xyz), LOWER_BODY
+    )
+    channels = tuple(f"{lab}.{c}" for lab in labels for c in "xyz")
+    meta = {
+        "units": units,
+        "up_axis": up,
+        "hip_method": "plug-in-gait outputs" if use_pig else "harrington2007",
+        "missing_keypoints": tuple(missing),
+        "events": _events(reader, fps),
+        "first_frame": int(reader.first_frame),
+    }
+    data = xyz.reshape(len(xyz), -1)
+    return Motion(fps, channels, data, keypoints, src, "c3d", filled=tuple(filled), meta=meta)
