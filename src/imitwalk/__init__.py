@@ -7,6 +7,11 @@ simulated in MuJoCo.
 
 from __future__ import annotations
 
+import os
+
+# Offscreen rendering on the CPU: MuJoCo reads MUJOCO_GL when it is first imported.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 from imitwalk.errors import (
     ConfigError,
     ImitwalkError,

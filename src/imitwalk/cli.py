@@ -1,83 +1,48 @@
 """The ``imitwalk`` command line.
 
-Every subcommand is a thin wrapper over the library. Errors the library raises on
-purpose (:class:`~imitwalk.errors.ImitwalkError`) print one line on stderr and exit
-with status 2; no traceback.
+Every subcommand is a thin wrapper over the library (:mod:`imitwalk.commands`). Errors
+the library raises on purpose (:class:`~imitwalk.errors.ImitwalkError`) print one line
+on stderr and exit with status 2; no traceback.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Sequence
 
+from imitwalk import commands
 from imitwalk.errors import ImitwalkError
 
 __all__ = ["build_parser", "main"]
 
 
-def _emit(obj: dict, as_json: bool) -> None:
-    if as_json:
-        print(json.dumps(obj, indent=2, default=float))
-        return
-    for key, val in obj.items():
-        if isinstance(val, dict | list) and len(json.dumps(val, default=float)) > 80:
-            val = json.dumps(val, default=float)[:77] + "..."
-        print(f"{key:>28}: {val}")
+def _robot_args(p: argparse.ArgumentParser, positional: bool = True) -> None:
+    if positional:
+        p.add_argument("robot", help="built-in robot (hoap2), an MJCF .xml, or a joint-map .json")
+    else:
+        p.add_argument("--robot", default="hoap2", help="robot (default hoap2)")
+    p.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
 
 
-def _robot_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("robot", help="built-in robot name (hoap2), an MJCF .xml, or a joint-map .json")
-    p.add_argument("--joint-map", help="joint-map JSON for an MJCF given as ROBOT")
-    p.add_argument("--json", action="store_true", help="print JSON")
+def _mocap_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "file",
+        nargs="?",
+        help="mocap file (.bvh, .amc, .c3d, DeepMimic .txt); default: pybullet's humanoid3d_walk",
+    )
+    p.add_argument("--skeleton", help="the ASF of an AMC file (default: the .asf beside it)")
+    p.add_argument("--units", help="BVH length unit: m, cm, mm, inch, cmu (default: detect)")
 
 
-def _cmd_robot_info(args: argparse.Namespace) -> int:
-    from imitwalk.robots import load_robot
-    from imitwalk.sim import SimOptions
-
-    r = load_robot(args.robot, args.joint_map)
-    opt = SimOptions()
-    info = {
-        "name": r.name,
-        "mjcf": str(r.mjcf),
-        "dof": r.dof,
-        "joints": {
-            n: {
-                "mjcf": j,
-                "min_rad": float(lo),
-                "max_rad": float(hi),
-                "kp_nm_per_rad": float(kp),
-                "torque_limit_nm": float(tl),
-            }
-            for n, j, (lo, hi), kp, tl in zip(
-                r.joint_names, r.mj_joints, r.limits, r.kp, r.torque_limit, strict=True
-            )
-        },
-        "total_mass_kg": r.total_mass,
-        "standing_height_m": r.height,
-        "standing_torso_height_m": r.torso_height,
-        "sensors": {
-            "gyro": r.gyro,
-            "accelerometer": r.accelerometer,
-            "foot_force": {s: list(v) for s, v in r.foot_force.items()},
-            "all": list(r.sensors),
-        },
-        "control_hz": opt.control_hz,
-        "physics_hz": opt.physics_hz,
-    }
-    _emit(info, args.json)
-    return 0
-
-
-def _cmd_robot_stand(args: argparse.Namespace) -> int:
-    from imitwalk.robots import load_robot
-    from imitwalk.standing import stand_test
-
-    res = stand_test(load_robot(args.robot, args.joint_map), seconds=args.seconds)
-    _emit(res.to_dict(), args.json)
-    return 1 if res.fell else 0
+def _settings(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a setting, e.g. search_config.generations=3 (repeatable)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -89,18 +54,49 @@ def build_parser() -> argparse.ArgumentParser:
     rsub = robot.add_subparsers(dest="robot_command", required=True)
     info = rsub.add_parser("info", help="joints, limits, mass, height, sensors, rates")
     _robot_args(info)
-    info.set_defaults(func=_cmd_robot_info)
-    stand = rsub.add_parser("stand", help="hold the standing keyframe and report tilt and forces")
+    info.add_argument("--json", action="store_true", help="print JSON")
+    info.set_defaults(func=commands.robot_info)
+    stand = rsub.add_parser("stand", help="hold the standing keyframe; report tilt and forces")
     _robot_args(stand)
-    stand.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (default 10)")
-    stand.set_defaults(func=_cmd_robot_stand)
+    stand.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (10)")
+    stand.add_argument("--json", action="store_true", help="print JSON")
+    stand.set_defaults(func=commands.robot_stand)
+
+    rt = sub.add_parser("retarget", help="mocap -> robot joint trajectory (.npz)")
+    _mocap_args(rt)
+    _robot_args(rt, positional=False)
+    rt.add_argument("--out", required=True, help="output .npz")
+    rt.add_argument(
+        "--mapping",
+        default="walkable",
+        choices=("walkable", "paper"),
+        help="walkable: IK on the robot (default); paper: human-sized skeleton",
+    )
+    rt.add_argument(
+        "--no-search",
+        action="store_true",
+        help="skip the reference-parameter search (use the defaults or --set)",
+    )
+    _settings(rt)
+    rt.add_argument("--json", action="store_true", help="print JSON")
+    rt.set_defaults(func=commands.retarget)
+
+    pb = sub.add_parser("playback", help="play a reference open loop on nominal + perturbed robots")
+    pb.add_argument("reference", help="a .npz written by retarget")
+    pb.add_argument("--scale", type=float, default=0.5, help="stride scale (0.5)")
+    pb.add_argument("--seconds", type=float, default=20.0, help="simulated seconds per robot (20)")
+    pb.add_argument("--models", type=int, default=6, help="robots: nominal + perturbed (6)")
+    pb.add_argument("--robot", default=None, help="robot (default: the reference's)")
+    pb.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
+    pb.add_argument("--workers", type=int, default=None, help="parallel processes (one per core)")
+    pb.add_argument("--json", action="store_true", help="print JSON")
+    pb.set_defaults(func=commands.playback)
     return p
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)
     except ImitwalkError as exc:
@@ -109,6 +105,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. piped into `head`
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

@@ -1,0 +1,141 @@
+"""The work behind each CLI subcommand (parsing lives in :mod:`imitwalk.cli`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+__all__ = ["emit", "playback", "progress", "retarget", "robot_from", "robot_info", "robot_stand"]
+
+
+def emit(obj: dict, as_json: bool) -> None:
+    """Print ``obj`` as JSON, or as aligned ``key: value`` lines."""
+    if as_json:
+        print(json.dumps(obj, indent=2, default=_plain))
+        return
+    for key, val in obj.items():
+        if isinstance(val, dict | list):
+            text = json.dumps(val, default=_plain)
+            val = text if len(text) <= 90 else text[:87] + "..."
+        elif isinstance(val, float):
+            val = f"{val:.4g}"
+        print(f"{key:>28}: {val}")
+
+
+def _plain(v):
+    if hasattr(v, "item"):
+        return v.item()
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    return str(v)
+
+
+def progress(message: str) -> None:
+    """One line of progress on stderr (stdout stays clean for ``--json``)."""
+    print(message, file=sys.stderr, flush=True)
+
+
+def robot_from(args: argparse.Namespace):
+    """Load the robot named by ``--robot`` / ``--joint-map`` (or the positional ``robot``)."""
+    from imitwalk.robots import load_robot
+
+    return load_robot(args.robot, getattr(args, "joint_map", None))
+
+
+def robot_info(args: argparse.Namespace) -> int:
+    from imitwalk.sim import SimOptions
+
+    r = robot_from(args)
+    opt = SimOptions()
+    joints = {
+        n: {
+            "mjcf": j,
+            "min_rad": float(lo),
+            "max_rad": float(hi),
+            "kp_nm_per_rad": float(kp),
+            "torque_limit_nm": float(tl),
+        }
+        for n, j, (lo, hi), kp, tl in zip(
+            r.joint_names, r.mj_joints, r.limits, r.kp, r.torque_limit, strict=True
+        )
+    }
+    emit(
+        {
+            "name": r.name,
+            "mjcf": str(r.mjcf),
+            "dof": r.dof,
+            "joints": joints,
+            "total_mass_kg": r.total_mass,
+            "standing_height_m": r.height,
+            "standing_torso_height_m": r.torso_height,
+            "sensors": {
+                "gyro": r.gyro,
+                "accelerometer": r.accelerometer,
+                "foot_force": {s: list(v) for s, v in r.foot_force.items()},
+                "all": list(r.sensors),
+            },
+            "control_hz": opt.control_hz,
+            "physics_hz": opt.physics_hz,
+        },
+        args.json,
+    )
+    return 0
+
+
+def robot_stand(args: argparse.Namespace) -> int:
+    from imitwalk.standing import stand_test
+
+    res = stand_test(robot_from(args), seconds=args.seconds)
+    emit(res.to_dict(), args.json)
+    return 1 if res.fell else 0
+
+
+def _motion(args: argparse.Namespace):
+    from imitwalk.mocap import default_clip, load_motion
+
+    path = args.file or default_clip()
+    return load_motion(path, skeleton=args.skeleton, units=getattr(args, "units", None))
+
+
+def retarget(args: argparse.Namespace) -> int:
+    from imitwalk.config import apply_overrides
+    from imitwalk.retarget import RetargetConfig
+    from imitwalk.retarget import retarget as run
+
+    robot = robot_from(args)
+    cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
+    cfg = apply_overrides(cfg, args.set)
+    motion = _motion(args)
+    progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
+
+    def report(gen, total, score, params):
+        shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
+        progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
+
+    res = run(motion, robot, cfg, progress=report)
+    res.reference.settings["robot"] = args.robot
+    res.reference.settings["joint_map"] = args.joint_map
+    res.reference.save(args.out)
+    stats = res.stats()
+    stats["out"] = str(Path(args.out))
+    emit(stats, args.json)
+    return 0
+
+
+def playback(args: argparse.Namespace) -> int:
+    from imitwalk.playback import play_reference, summary
+    from imitwalk.retarget import Reference
+
+    ref = Reference.load(args.reference)
+    if args.robot is None:
+        args.robot = ref.settings.get("robot", ref.robot)
+        args.joint_map = ref.settings.get("joint_map")
+    robot = robot_from(args)
+    seeds = list(range(args.models))
+    progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
+    runs = play_reference(ref, robot, args.scale, args.seconds, seeds, workers=args.workers)
+    out = {"scale": args.scale, "seconds": args.seconds, **summary(runs)}
+    emit(out, args.json)
+    return 0

@@ -1,0 +1,81 @@
+"""Settings: frozen dataclasses per stage, and dotted ``key=value`` overrides.
+
+``apply_overrides(cfg, ["search.generations=2", "params.sway=0.8"])`` returns a copy
+of ``cfg`` with those fields replaced, converting each value to the type of the
+field it replaces. An unknown key raises :class:`~imitwalk.errors.ConfigError`
+listing the valid ones.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from typing import Any
+
+from imitwalk.errors import ConfigError, unknown_name
+
+__all__ = ["apply_overrides", "to_dict"]
+
+
+def _coerce(text: str, current: Any, key: str) -> Any:
+    try:
+        if isinstance(current, bool):
+            if text.lower() in ("1", "true", "yes", "on"):
+                return True
+            if text.lower() in ("0", "false", "no", "off"):
+                return False
+            raise ValueError
+        if isinstance(current, int) and not isinstance(current, bool):
+            return int(text)
+        if isinstance(current, float):
+            return float(text)
+        if isinstance(current, tuple):
+            items = json.loads(text) if text.startswith("[") else text.split(",")
+            kind = type(current[0]) if current else float
+            return tuple(kind(x) for x in items)
+        if current is None:
+            return None if text.lower() == "none" else json.loads(text)
+        return type(current)(text)
+    except (ValueError, TypeError, json.JSONDecodeError):
+        raise ConfigError(f"setting {key}={text!r}: expected {type(current).__name__}") from None
+
+
+def _replace(obj: Any, path: list[str], text: str, full: str) -> Any:
+    if not dataclasses.is_dataclass(obj):
+        raise ConfigError(f"setting {full!r}: {path[0]!r} is not a group of settings")
+    names = [f.name for f in dataclasses.fields(obj)]
+    if path[0] not in names:
+        raise unknown_name(
+            "setting", full, [_prefix(full, path[0]) + n for n in names], ConfigError
+        )
+    current = getattr(obj, path[0])
+    if len(path) == 1:
+        if dataclasses.is_dataclass(current):
+            raise ConfigError(f"setting {full!r} is a group; set one of its fields")
+        if isinstance(current, str) and hasattr(obj, "CHOICES") and path[0] in obj.CHOICES:
+            if text not in obj.CHOICES[path[0]]:
+                raise unknown_name(f"value for {full}", text, obj.CHOICES[path[0]], ConfigError)
+        value = _coerce(text, current, full)
+    else:
+        value = _replace(current, path[1:], text, full)
+    return dataclasses.replace(obj, **{path[0]: value})
+
+
+def _prefix(full: str, last: str) -> str:
+    head = full.rsplit(".", 1)[0] + "." if "." in full and not full.startswith(last) else ""
+    return head
+
+
+def apply_overrides(cfg: Any, overrides: list[str] | tuple[str, ...] | None) -> Any:
+    """A copy of ``cfg`` with each ``"a.b.c=value"`` override applied."""
+    for item in overrides or ():
+        if "=" not in item:
+            raise ConfigError(f"setting {item!r} must look like key=value")
+        key, text = item.split("=", 1)
+        cfg = _replace(cfg, key.strip().split("."), text.strip(), key.strip())
+    return cfg
+
+
+def to_dict(cfg: Any) -> dict:
+    """Plain-JSON dictionary of a (nested) settings dataclass."""
+    return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))

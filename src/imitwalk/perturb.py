@@ -1,0 +1,52 @@
+"""Perturbed robots for evaluation and for training (pure NumPy).
+
+Seed 0 is the nominal robot. Every other seed draws a perturbed one: each body's mass
+±5 %, the floor friction 0.7-1.0, each servo's stiffness ±10 %, and (for the
+evaluation of a learned gait) a small initial disturbance of the base velocity.
+Evaluation seeds are 0-99; learning and the reference search only use seeds from
+:data:`TRAIN_SEED_BASE` up, so they never see an evaluation robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from imitwalk.sim import SimOptions
+
+__all__ = ["TRAIN_SEED_BASE", "perturbed", "train_seeds"]
+
+#: Seeds at or above this are reserved for learning and searching.
+TRAIN_SEED_BASE = 1000
+
+
+def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = False) -> SimOptions:
+    """Simulation options of robot ``seed`` (0: nominal, as ``base``).
+
+    Args:
+        seed: which robot; also seeds its sensor noise.
+        base: options to perturb (rates, noise, slope ... are kept).
+        disturbance: also give the base a small random initial velocity
+            (σ 0.02 m/s linear, 0.1 rad/s angular).
+    """
+    base = base or SimOptions()
+    if seed == 0:
+        return replace(base, seed=0)
+    rng = np.random.default_rng([seed, 20070106])
+    twist = (0.0,) * 6
+    if disturbance:
+        twist = tuple(np.concatenate([rng.normal(0, 0.02, 3), rng.normal(0, 0.1, 3)]).tolist())
+    return replace(
+        base,
+        seed=seed,
+        mass_jitter=0.05,
+        kp_jitter=0.10,
+        friction=float(rng.uniform(0.7, 1.0)),
+        init_twist=twist,
+    )
+
+
+def train_seeds(n: int) -> tuple[int, ...]:
+    """``n`` robots for learning: the nominal one, then training perturbations."""
+    return (0, *range(TRAIN_SEED_BASE + 1, TRAIN_SEED_BASE + n))

@@ -1,0 +1,94 @@
+"""Kinematic checks of a retargeted gait, by forward kinematics only."""
+
+from __future__ import annotations
+
+import itertools
+
+import mujoco
+import numpy as np
+
+from imitwalk.robots import Robot
+
+__all__ = ["kinematic_checks"]
+
+
+def _sole(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
+        i = model.site(name).id
+        return data.site_xpos[i].copy(), data.site_xmat[i].reshape(3, 3).copy()
+    i = model.body(name).id
+    return data.xpos[i].copy(), data.xmat[i].reshape(3, 3).copy()
+
+
+def _closure(q: np.ndarray) -> float:
+    """How much bigger the wrap-around step q[-1] → q[0] is than any step inside the loop.
+
+    Per joint, ``max(0, |q[0] - q[-1]| - max_t |q[t+1] - q[t]|)``, the worst joint [rad]:
+    zero for a closed loop, the size of the jump for one that is not.
+    """
+    if len(q) < 3:
+        return 0.0
+    inner = np.abs(np.diff(q, axis=0)).max(axis=0)
+    return float(np.clip(np.abs(q[0] - q[-1]) - inner, 0.0, None).max())
+
+
+def kinematic_checks(
+    robot: Robot, qpos: np.ndarray, stance: np.ndarray, phase_sigma: np.ndarray, q: np.ndarray
+) -> dict:
+    """Replay whole-body states kinematically and measure the gait.
+
+    Args:
+        robot: the robot; qpos: ``(N, nq)`` states of one or more cycles (time order).
+        stance: ``(N, 2)`` bool, left/right foot planned on the floor.
+        phase_sigma: ``(N, 2)`` swing progress σ ∈ [0, 1] of each foot (NaN in stance).
+        q: ``(N, n)`` joint angles of exactly one closed loop (for the wrap check).
+
+    Returns:
+        ``stance_tilt_deg_max``, ``swing_clearance_mm_min`` (at mid-swing),
+        ``foot_skate_mm_per_step``, ``loop_closure_rad_max`` (see :func:`_closure`),
+        ``feet_alternate``,
+        ``steps_forward``, ``knee_min_deg``.
+    """
+    m = robot.compile()
+    d = mujoco.MjData(m)
+    n = len(qpos)
+    pos = np.zeros((n, 2, 3))
+    tilt = np.zeros((n, 2))
+    for i in range(n):
+        d.qpos[:] = qpos[i]
+        mujoco.mj_kinematics(m, d)
+        for j, s in enumerate("lr"):
+            p, rmat = _sole(m, d, robot.soles[s])
+            pos[i, j] = p
+            tilt[i, j] = np.degrees(np.arccos(np.clip(rmat[2, 2], -1.0, 1.0)))
+    stance_tilt = float(tilt[stance].max()) if stance.any() else 0.0
+    mid = np.abs(phase_sigma - 0.5) <= 0.5 / max(1, np.sum(~stance[:, 0]) // 2)
+    clearance = float(pos[:, :, 2][mid].min() * 1000) if mid.any() else float("nan")
+    skate, landings = [], []
+    for j in range(2):
+        c = stance[:, j].astype(int)
+        starts = np.flatnonzero(np.diff(c) == 1) + 1
+        ends = np.flatnonzero(np.diff(c) == -1) + 1
+        for a in starts:
+            b = ends[ends > a]
+            b = b[0] if len(b) else n
+            xy = pos[a:b, j, :2]
+            skate.append(float(np.linalg.norm(xy.max(0) - xy.min(0)) * 1000))
+            landings.append((a, j, float(pos[a, j, 0])))
+    landings.sort()
+    order = [j for _, j, _ in landings]
+    alternate = all(a != b for a, b in itertools.pairwise(order))
+    forward = all(
+        x2 > x1 + 1e-4 for (_, j1, x1), (_, j2, x2) in itertools.pairwise(landings) if j1 != j2
+    )
+    wrap = _closure(q)
+    knees = [robot.index(k) for k in ("l_knee", "r_knee") if k in robot.joint_names]
+    return {
+        "stance_tilt_deg_max": stance_tilt,
+        "swing_clearance_mm_min": clearance,
+        "foot_skate_mm_per_step": float(np.mean(skate)) if skate else 0.0,
+        "loop_closure_rad_max": float(wrap),
+        "feet_alternate": bool(alternate and len(order) >= 2),
+        "steps_forward": bool(forward),
+        "knee_min_deg": float(np.degrees(q[:, knees].min())) if knees else float("nan"),
+    }

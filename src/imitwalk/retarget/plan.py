@@ -1,0 +1,268 @@
+"""The robot's gait in task space: where the feet, the centre of mass and the pelvis go.
+
+This is the walkable reference's plan (pure NumPy). Given the human
+:class:`~imitwalk.retarget.template.GaitTemplate`, the robot's leg geometry, the
+four reference parameters (:class:`GaitParams`) and a stride scale, it lays out, per
+control tick:
+
+* the **stance foot** flat and fixed on the floor;
+* the **swing foot** along the human foot path (its forward progress and lift profile,
+  scaled to the robot), flat, with clearance;
+* the **centre of mass** moving forward steadily with a smooth **sinusoidal** lateral
+  sway over the stance foot (a square-wave sway builds up a growing roll);
+* the **pelvis** level, at a fixed height chosen to keep the knee bent;
+* the **arms and waist** swinging as the human's do (scaled with the stride).
+
+Timing: the human cycle time; ``ds`` double support per transition; ψ = 0 is the left
+heel strike, the right foot swings in ψ ∈ [ds, ½), the left in [½ + ds, 1). An
+amplitude envelope ``e(t)`` ∈ [0, 1] scales stride, sway, lift and arm swing, so one
+code path gives both the start-up from standing (``e`` rising over the first cycle)
+and the steady loop (``e ≡ 1``), which is closed by construction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from imitwalk.retarget.template import GaitTemplate
+
+__all__ = [
+    "KNEE_MIN_DEG",
+    "START_CYCLES",
+    "GaitParams",
+    "LegGeometry",
+    "TaskPlan",
+    "knee_cap",
+    "plan_walk",
+]
+
+#: Start-up cycles: one of sway with both feet down, then two of growing stride.
+START_CYCLES = 3
+
+#: The knee keeps at least this flexion at the longest stride [deg] (a straight knee at
+#: full stride was why a prototype's full-scale gait failed).
+KNEE_MIN_DEG = 20.0
+
+
+@dataclass(frozen=True)
+class GaitParams:
+    """The reference's few parameters, found by trials in simulation (``search.py``).
+
+    Attributes:
+        sway: lateral CoM amplitude ÷ the lateral offset of the feet (about 0.9 worked).
+        height: hip height ÷ the straight-leg hip height (knee stays bent below 1).
+        lift: swing foot clearance at its peak [m].
+        ds: double-support fraction of the cycle, per transition (about 0.1 worked).
+        lean: centre of mass ahead of the feet's midpoint [m]; a compliant robot sags
+            backwards under its own weight, so a few millimetres may be needed.
+        width: extra lateral offset of each foot beyond its hip [m].
+    """
+
+    sway: float = 0.9
+    height: float = 0.9
+    lift: float = 0.02
+    ds: float = 0.1
+    lean: float = 0.0
+    width: float = 0.0
+
+    def to_dict(self) -> dict:
+        """Plain dictionary."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class LegGeometry:
+    """The robot's leg measures, from its model.
+
+    Attributes:
+        hip_y: lateral offset of each hip centre from the pelvis centre [m].
+        hip_z: hip centre below the pelvis frame [m] (positive down).
+        leg: hip centre to ankle with the leg straight [m].
+        ankle: ankle to sole [m].
+        sole_x: sole centre ahead of the ankle [m].
+        foot_length: sole length [m].
+        hip_ahead: hips ahead of the centre of mass when standing [m].
+    """
+
+    hip_y: float
+    hip_z: float
+    leg: float
+    ankle: float
+    sole_x: float
+    foot_length: float
+    hip_ahead: float = 0.0
+
+    @property
+    def hip_height(self) -> float:
+        """Hip centre above the sole with the leg straight [m]."""
+        return self.leg + self.ankle
+
+
+@dataclass(frozen=True)
+class TaskPlan:
+    """Per-tick task-space targets (``N`` ticks of ``dt``).
+
+    ``l_sole``/``r_sole`` ``(N, 3)`` sole-centre positions [m] (soles flat, heading +x);
+    ``com`` ``(N, 2)`` centre of mass x, y [m]; ``pelvis_z`` ``(N,)`` pelvis-frame
+    height [m]; ``upper`` dict role → ``(N,)`` arm and waist angles [rad], offsets from
+    the standing posture; ``phase`` ``(N,)`` ψ; ``stance`` ``(N, 2)`` bool, left/right
+    foot on the floor; ``swing`` ``(N, 2)`` swing progress σ ∈ [0, 1] of each foot
+    (NaN in stance); ``envelope`` ``(N,)``; ``stride`` per steady cycle [m]; ``period`` [s].
+    """
+
+    dt: float
+    l_sole: np.ndarray
+    r_sole: np.ndarray
+    com: np.ndarray
+    pelvis_z: np.ndarray
+    upper: dict
+    phase: np.ndarray
+    stance: np.ndarray
+    swing: np.ndarray
+    envelope: np.ndarray
+    stride: float
+    period: float
+
+
+def _smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * x * (x * (6.0 * x - 15.0) + 10.0)
+
+
+def _profile(p: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Evaluate a ``(PHASES,)`` profile sampled on [0, 1] at ``s``."""
+    return np.interp(s, np.linspace(0.0, 1.0, len(p)), p)
+
+
+def plan_walk(
+    template: GaitTemplate,
+    geom: LegGeometry,
+    params: GaitParams,
+    scale: float,
+    dt: float,
+    cycles: int = 1,
+    start: bool = False,
+    cap_scale: float | None = 1.0,
+) -> TaskPlan:
+    """Lay out ``cycles`` steady cycles, after :data:`START_CYCLES` start-up cycles if ``start``.
+
+    The start-up begins standing with both feet side by side: in its first cycle the
+    sway builds up while both feet stay down; then the feet step, with the stride
+    growing smoothly from zero; then the steady cycles follow.
+
+    Args:
+        template: the human gait; geom: the robot's legs; params: reference parameters.
+        scale: stride scale (1.0: the human stride scaled by the leg-length ratio).
+        dt: control period [s]; the cycle time is rounded to a whole number of ticks.
+        cycles: steady cycles (envelope 1); start: prepend the start-up cycles.
+        cap_scale: the longest stride the gait is built for; the hip is never higher
+            than :func:`knee_cap` allows at that stride (or at ``scale`` if longer), so
+            the knee stays bent; ``None`` for no cap.
+    """
+    n_cyc = max(2, round(template.period / dt))
+    period = n_cyc * dt
+    stride = scale * template.stride * geom.leg / template.leg_length
+    ds = float(np.clip(params.ds, 0.0, 0.45))
+    ramp = START_CYCLES if start else 0
+    n_out = n_cyc * (ramp + cycles)
+    n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
+    k = np.arange(n)
+    psi = (k % n_cyc) / n_cyc
+    # the sway builds up over the first start-up cycle (feet down), so the lateral rocking
+    # is in full swing before a foot leaves the floor; then the stride grows over the
+    # other start-up cycles, slowly enough that no step is longer than a steady one
+    e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
+    e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
+    stepping = k >= (n_cyc if start else 0)
+    v = stride / period
+    com_x = np.cumsum(e) * v * dt - e[0] * v * dt  # (N,) integrated forward travel
+    if not start:  # steady: CoM midway between the feet at mid double support
+        com_x = com_x - stride / 4 - stride * ds / 2
+    y_foot = geom.hip_y + params.width
+    com_y = e_sway * params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
+    soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
+    stance = np.zeros((n, 2), dtype=bool)
+    swing = np.full((n, 2), np.nan)
+    # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
+    windows = {"r": (ds, 0.5), "l": (0.5 + ds, 1.0)}
+    land_x = {"l": 0.0, "r": 0.0 if start else -stride / 2}
+    lift_off = dict(land_x)
+    shape_z = np.maximum(
+        template.swing_z, np.sin(np.pi * np.linspace(0.0, 1.0, len(template.swing_z)))
+    )
+    shape_z /= shape_z.max()
+    for i in range(n):
+        for j, f in enumerate("lr"):
+            a, b = windows[f]
+            if stepping[i] and a <= psi[i] < b:
+                sigma = (psi[i] - a) / (b - a)
+                if sigma * (b - a) * n_cyc < 1.0:  # first swing tick: choose the landing spot
+                    lift_off[f] = land_x[f]
+                    t_mid = i - sigma * (b - a) * n_cyc + (b - a + ds / 2) * n_cyc  # fractional
+                    land_x[f] = _com_at(com_x, t_mid) + _com_at(e, t_mid) * stride / 4
+                x = lift_off[f] + (land_x[f] - lift_off[f]) * _profile(template.swing_x, sigma)
+                z = params.lift * _profile(shape_z, sigma)
+                soles[f][i] = (x, 0.0, z)
+                swing[i, j] = sigma
+            else:
+                soles[f][i] = (land_x[f], 0.0, 0.0)
+                stance[i, j] = True
+    soles["l"][:, 1], soles["r"][:, 1] = y_foot, -y_foot
+    hip = params.height * geom.hip_height
+    if cap_scale is not None:
+        hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start))
+    pelvis_z = np.full(n, hip + geom.hip_z)
+    grid = np.arange(len(template.waist)) / len(template.waist)
+    arm = lambda prof: np.interp(psi, grid, prof, period=1.0)  # noqa: E731
+    amp = e * scale
+    upper = {
+        "l_shoulder_pitch": -amp * arm(template.shoulder[:, 0] - template.shoulder[:, 0].mean()),
+        "r_shoulder_pitch": -amp * arm(template.shoulder[:, 1] - template.shoulder[:, 1].mean()),
+        "l_elbow": -amp * arm(template.elbow[:, 0] - template.elbow[:, 0].mean()),
+        "r_elbow": -amp * arm(template.elbow[:, 1] - template.elbow[:, 1].mean()),
+        "waist_yaw": amp * arm(template.waist),
+    }
+    cut = slice(0, n_out)
+    return TaskPlan(
+        dt=dt,
+        l_sole=soles["l"][cut],
+        r_sole=soles["r"][cut],
+        com=np.stack([com_x + params.lean, com_y], axis=1)[cut],
+        pelvis_z=pelvis_z[cut],
+        upper={key: val[cut] for key, val in upper.items()},
+        phase=psi[cut],
+        stance=stance[cut],
+        swing=swing[cut],
+        envelope=e[cut],
+        stride=stride,
+        period=period,
+    )
+
+
+def knee_cap(
+    template: GaitTemplate, geom: LegGeometry, params: GaitParams, scale: float, start: bool = True
+) -> float:
+    """Highest hip height above the soles [m] that keeps the knee bent ``KNEE_MIN_DEG``.
+
+    Measured on the plan of the longest stride (``scale``), start-up included if
+    ``start``, with a steady cycle after it: at every tick, each
+    ankle (sole minus its offsets) must be within ``leg * cos(κ/2)`` of its hip (thigh and
+    shank taken as equal, so a knee bent by κ shortens the leg by that factor), the hip
+    taken ``hip_ahead`` in front of the centre of mass and ``hip_y`` to the side.
+    """
+    plan = plan_walk(template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None)
+    reach = geom.leg * np.cos(np.radians(KNEE_MIN_DEG) / 2)
+    best = np.inf
+    for side, sole in ((1.0, plan.l_sole), (-1.0, plan.r_sole)):
+        dx = plan.com[:, 0] + geom.hip_ahead - (sole[:, 0] - geom.sole_x)
+        dy = plan.com[:, 1] + side * geom.hip_y - sole[:, 1]
+        dz2 = np.maximum(reach**2 - dx**2 - dy**2, (0.5 * geom.leg) ** 2)
+        best = min(best, float(np.min(np.sqrt(dz2) + sole[:, 2] + geom.ankle)))
+    return best
+
+
+def _com_at(series: np.ndarray, t: float) -> float:
+    """``series`` (one value per tick) at fractional tick ``t``, linearly interpolated."""
+    return float(np.interp(t, np.arange(len(series)), series))

@@ -1,0 +1,181 @@
+"""The retargeted gait as a typed record, saved and loaded as ``.npz``.
+
+A :class:`Reference` holds, for a grid of stride scales, one closed gait cycle of
+robot joint angles (the loop) and the start-up from standing that leads into it,
+plus everything needed to judge it: IK residuals, clipped joints, kinematic checks,
+the reference parameters and the search that found them, and where it came from.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk.errors import RunError
+
+__all__ = ["Reference", "atomic_write"]
+
+
+def atomic_write(path: str | Path, write) -> Path:
+    """Write a file atomically: ``write(tmp_path)`` then rename over ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+@dataclass
+class Reference:
+    """A robot gait retargeted from mocap.
+
+    Attributes:
+        robot: robot name; joint_names: ``n`` roles, the columns of every trajectory.
+        mapping: ``"walkable"`` (IK on the robot, the default) or ``"paper"``.
+        dt: control period [s]; period: cycle time [s] (a whole number of ticks).
+        scales: ``(S,)`` stride scales of the grid.
+        loops: ``(S, N, n)`` one closed cycle per scale [rad]; loops[s, 0] follows loops[s, -1].
+        starts: ``(S, M, n)`` start-up from standing into loops[s, 0] [rad].
+        strides: ``(S,)`` forward travel per cycle [m].
+        start_travel: ``(S, M)`` forward travel the start-up commands by each tick [m].
+        phase: ``(N,)`` gait phase ψ of each loop tick (0 at the left heel strike).
+        stance: ``(N, 2)`` bool, left/right foot planned on the floor.
+        residual_mm: ``(S, M + N)`` worst IK task error per tick [mm].
+        clipped: one dict per (scale, joint) that sat on a joint limit.
+        checks: kinematic checks of the largest scale (tilt, clearance, closure, skate).
+        params: the reference parameters; search: the report of the search for them.
+        source: the mocap file; settings: how it was retargeted; cycles: ``(C, 2)``
+            source frames of the gait cycles used.
+    """
+
+    robot: str
+    joint_names: tuple[str, ...]
+    mapping: str
+    dt: float
+    period: float
+    scales: np.ndarray
+    loops: np.ndarray
+    starts: np.ndarray
+    strides: np.ndarray
+    start_travel: np.ndarray
+    phase: np.ndarray
+    stance: np.ndarray
+    residual_mm: np.ndarray
+    clipped: list = field(default_factory=list)
+    checks: dict = field(default_factory=dict)
+    params: dict = field(default_factory=dict)
+    search: dict = field(default_factory=dict)
+    source: str = ""
+    settings: dict = field(default_factory=dict)
+    cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+
+    # -- access ---------------------------------------------------------------
+    def _bracket(self, scale: float) -> tuple[int, int, float]:
+        s = self.scales
+        if not s[0] - 1e-9 <= scale <= s[-1] + 1e-9:
+            raise RunError(f"scale {scale} is outside the reference's range {s[0]:g}..{s[-1]:g}")
+        if len(s) == 1:
+            return 0, 0, 0.0
+        j = int(np.clip(np.searchsorted(s, scale), 1, len(s) - 1))
+        w = float(np.clip((scale - s[j - 1]) / (s[j] - s[j - 1]), 0.0, 1.0))
+        return j - 1, j, w
+
+    def at_scale(self, scale: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """Start-up ``(M, n)``, loop ``(N, n)`` and stride [m] at ``scale``.
+
+        Between grid scales the two neighbouring IK solutions are blended linearly.
+        """
+        i, j, w = self._bracket(scale)
+        mix = lambda a: (1.0 - w) * a[i] + w * a[j]  # noqa: E731
+        return mix(self.starts), mix(self.loops), float(mix(self.strides))
+
+    def trajectory(self, scale: float, seconds: float) -> np.ndarray:
+        """``(T, n)`` joint targets for ``seconds``: the start-up, then the loop repeated."""
+        start, loop, _ = self.at_scale(scale)
+        steps = max(1, round(seconds / self.dt))
+        reps = int(np.ceil(max(0, steps - len(start)) / len(loop))) + 1
+        return np.vstack([start, *([loop] * reps)])[:steps]
+
+    def expected_distance(self, scale: float, seconds: float) -> float:
+        """Forward travel [m] the reference commands over ``seconds`` from standing.
+
+        The start-up's own commanded travel, then a stride per cycle of the loop.
+        """
+        i, j, w = self._bracket(scale)
+        travel = (1.0 - w) * self.start_travel[i] + w * self.start_travel[j]
+        _, _, stride = self.at_scale(scale)
+        k = round(seconds / self.dt)
+        m, n = self.starts.shape[1], self.loops.shape[1]
+        if k <= m:
+            return float(travel[max(0, k - 1)])
+        return float(travel[-1] + stride * (k - m) / n)
+
+    # -- persistence ----------------------------------------------------------
+    def save(self, path: str | Path) -> Path:
+        """Write ``path`` (``.npz``) atomically."""
+        arrays = {}
+        meta = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                arrays[f.name] = v
+            else:
+                meta[f.name] = v
+        arrays["q"] = self.loops[-1]  # the joint trajectory at the largest scale, (N, n)
+        arrays["meta_json"] = np.array(json.dumps(meta, default=_jsonable))
+
+        def write(tmp: Path) -> None:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
+
+        return atomic_write(path, write)
+
+    @classmethod
+    def load(cls, path: str | Path) -> Reference:
+        """Read a reference written by :meth:`save`."""
+        path = Path(path)
+        if not path.is_file():
+            raise RunError(f"reference file not found: {path}")
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                meta = json.loads(str(z["meta_json"]))
+                arrays = {k: z[k] for k in z.files if k not in ("meta_json", "q")}
+        except (OSError, ValueError, KeyError) as exc:
+            raise RunError(f"{path} is not an imitwalk reference: {exc}") from None
+        meta["joint_names"] = tuple(meta["joint_names"])
+        return cls(**meta, **arrays)
+
+    def summary(self) -> dict:
+        """Plain-JSON description (no per-tick arrays)."""
+        return {
+            "robot": self.robot,
+            "mapping": self.mapping,
+            "dt": self.dt,
+            "period_s": self.period,
+            "scales": self.scales.tolist(),
+            "strides_m": self.strides.tolist(),
+            "params": self.params,
+            "checks": self.checks,
+            "source": self.source,
+        }
+
+
+def _jsonable(v):
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if hasattr(v, "__dataclass_fields__"):
+        return asdict(v)
+    raise TypeError(f"not JSON serialisable: {type(v).__name__}")

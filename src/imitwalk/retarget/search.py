@@ -1,0 +1,152 @@
+"""A small model-free search for the reference parameters, by trials in simulation.
+
+In the spirit of the paper (no dynamics model), the few parameters of the walkable
+reference (:class:`~imitwalk.retarget.plan.GaitParams`: sway, pelvis height, lift,
+double support, lean, width) are chosen by the cross-entropy method over open-loop
+rollouts: each candidate reference is solved by IK at a few stride scales and played
+on the nominal robot and on training perturbations (never an evaluation robot). A
+rollout scores ``alive fraction + ½·min(progress ratio, 1) − ½·min(|yaw drift| / 45°, 1)``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, fields, replace
+
+import numpy as np
+
+from imitwalk.metrics import walk_metrics
+from imitwalk.parallel import run_parallel
+from imitwalk.perturb import perturbed, train_seeds
+from imitwalk.retarget.ik import WalkIK
+from imitwalk.retarget.plan import GaitParams
+from imitwalk.retarget.template import GaitTemplate
+from imitwalk.retarget.walkable import build_walkable
+from imitwalk.robots import Robot
+from imitwalk.sim import MujocoPlant, SimOptions, playback
+
+__all__ = ["BOUNDS", "SearchConfig", "search_params"]
+
+#: Search range of each reference parameter.
+BOUNDS: dict[str, tuple[float, float]] = {
+    "sway": (0.4, 1.1),
+    "height": (0.80, 0.98),
+    "lift": (0.015, 0.045),
+    "ds": (0.05, 0.3),
+    "lean": (-0.005, 0.02),
+    "width": (0.0, 0.015),
+}
+
+
+@dataclass(frozen=True)
+class SearchConfig:
+    """Budget of the search.
+
+    Attributes:
+        generations, population, elites: cross-entropy method sizes.
+        scales: stride scales every candidate is tried at.
+        models: number of robots per trial (the nominal one + training perturbations).
+        seconds: simulated time per rollout [s]; seed: the search's random seed.
+        workers: parallel processes (``None``: one per core).
+    """
+
+    generations: int = 5
+    population: int = 8
+    elites: int = 3
+    scales: tuple[float, ...] = (0.5, 1.0)
+    models: int = 2
+    seconds: float = 12.0
+    seed: int = 0
+    workers: int | None = None
+
+
+_IK: dict = {}
+
+
+def _trial(job) -> dict:
+    template, robot, params, cfg, dt, base = job
+    key = (robot.name, str(robot.mjcf))
+    ik = _IK.setdefault(key, WalkIK(robot))
+    ref = build_walkable(template, robot, params, list(cfg.scales), dt, ik=ik).reference
+    runs, score = [], []
+    for s in cfg.scales:
+        q = ref.trajectory(s, cfg.seconds)
+        for seed in train_seeds(cfg.models):
+            ro = playback(MujocoPlant(robot, perturbed(seed, base)), q, q0=q[0])
+            m = walk_metrics(ro, ref.expected_distance(s, ro.seconds))
+            val = (
+                ro.seconds / cfg.seconds
+                + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
+                - 0.5 * min(abs(m.yaw_drift_deg) / 45.0, 1.0)
+            )
+            score.append(val)
+            runs.append(
+                {
+                    "scale": s,
+                    "seed": seed,
+                    "fell": m.fell,
+                    "seconds": m.seconds,
+                    "progress_ratio": m.progress_ratio,
+                    "yaw_drift_deg": m.yaw_drift_deg,
+                }
+            )
+    return {"params": params.to_dict(), "score": float(np.mean(score)), "runs": runs}
+
+
+def search_params(
+    template: GaitTemplate,
+    robot: Robot,
+    config: SearchConfig | None = None,
+    start: GaitParams | None = None,
+    dt: float = 0.01,
+    base: SimOptions | None = None,
+    progress=None,
+) -> tuple[GaitParams, dict]:
+    """Find reference parameters for ``template`` on ``robot``.
+
+    Returns:
+        the best parameters found and a JSON-able report of every trial.
+    """
+    cfg = config or SearchConfig()
+    names = [f.name for f in fields(GaitParams)]
+    lo = np.array([BOUNDS[n][0] for n in names])
+    hi = np.array([BOUNDS[n][1] for n in names])
+    x0 = np.array([getattr(start or GaitParams(), n) for n in names])
+    mu = np.clip((x0 - lo) / (hi - lo), 0.0, 1.0)
+    sd = np.full(len(names), 0.25)
+    rng = np.random.default_rng(cfg.seed)
+    history, best = [], None
+    t0 = time.perf_counter()
+    for gen in range(cfg.generations):
+        u = np.clip(mu + sd * rng.standard_normal((cfg.population, len(names))), 0.0, 1.0)
+        if gen == 0:
+            u[0] = mu
+        cands = [
+            GaitParams(**dict(zip(names, (lo + ui * (hi - lo)).tolist(), strict=True))) for ui in u
+        ]
+        jobs = [(template, robot, c, cfg, dt, base) for c in cands]
+        results = run_parallel(_trial, jobs, cfg.workers)
+        scores = np.array([r["score"] for r in results])
+        order = np.argsort(-scores, kind="stable")
+        elite = u[order[: cfg.elites]]
+        mu, sd = elite.mean(axis=0), np.maximum(elite.std(axis=0), 0.05)
+        for i, r in enumerate(results):
+            history.append({"generation": gen, "candidate": i, **r})
+        top = results[order[0]]
+        if best is None or top["score"] > best["score"]:
+            best = top
+        if progress:
+            progress(gen + 1, cfg.generations, best["score"], best["params"])
+    per = len(cfg.scales) * cfg.models * cfg.seconds
+    report = {
+        "method": "cross-entropy method over open-loop rollouts",
+        "config": asdict(replace(cfg, workers=None)),
+        "bounds": BOUNDS,
+        "score": "alive fraction + 0.5*min(progress,1) - 0.5*min(|yaw|/45deg,1), mean over runs",
+        "evaluations": len(history),
+        "sim_seconds": len(history) * per,
+        "wall_seconds": time.perf_counter() - t0,
+        "best": best,
+        "history": history,
+    }
+    return GaitParams(**best["params"]), report
