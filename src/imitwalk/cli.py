@@ -91,6 +91,44 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("--workers", type=int, default=None, help="parallel processes (one per core)")
     pb.add_argument("--json", action="store_true", help="print JSON")
     pb.set_defaults(func=commands.playback)
+    ln = sub.add_parser("learn", help="learn to walk a mocap clip (retargets it first)")
+    _mocap_args(ln)
+    _robot_args(ln, positional=False)
+    ln.add_argument("--out", required=True, help="run folder")
+    ln.add_argument("--reference", help="a .npz from retarget (skip retargeting)")
+    ln.add_argument(
+        "--variant",
+        default="extended",
+        choices=("extended", "faithful"),
+        help="extended (default) or the paper as written (faithful)",
+    )
+    ln.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    ln.add_argument("--resume", action="store_true", help="continue an interrupted run")
+    ln.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a learning setting (e.g. schedule.stop=0.8), or a "
+        "retargeting one with a retarget. prefix (repeatable)",
+    )
+    ln.add_argument("--json", action="store_true", help="print JSON")
+    ln.set_defaults(func=commands.learn)
+
+    ev = sub.add_parser("evaluate", help="learned gait vs open-loop playback on perturbed robots")
+    ev.add_argument("run_dir", help="a run folder written by learn")
+    ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
+    ev.add_argument("--seeds", type=int, default=10, help="robots: nominal + perturbed (10)")
+    ev.add_argument("--perturb", action="store_true", help="run the robustness grid instead")
+    ev.add_argument("--robot", default=None, help="robot (default: the run's)")
+    ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
+    ev.add_argument("--workers", type=int, default=None, help="parallel processes")
+    ev.add_argument("--json", action="store_true", help="print JSON")
+    ev.set_defaults(func=commands.evaluate)
+    dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
+    dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")
+    dm.add_argument("--json", action="store_true", help="print JSON")
+    dm.set_defaults(func=commands.demo)
     return p
 
 

@@ -139,3 +139,150 @@ def playback(args: argparse.Namespace) -> int:
     out = {"scale": args.scale, "seconds": args.seconds, **summary(runs)}
     emit(out, args.json)
     return 0
+
+
+def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
+    """``--set`` items for the retargeting (``retarget.``-prefixed) and for learning."""
+    rt = [i.split(".", 1)[1] for i in items if i.startswith("retarget.")]
+    return rt, [i for i in items if not i.startswith("retarget.")]
+
+
+def learn(args: argparse.Namespace) -> int:
+    from imitwalk.config import apply_overrides
+    from imitwalk.learnconfig import preset
+    from imitwalk.learner import learn as run
+    from imitwalk.retarget import Reference, RetargetConfig
+    from imitwalk.retarget import retarget as do_retarget
+    from imitwalk.runs import RunDir
+
+    robot = robot_from(args)
+    rt_set, learn_set = _split_settings(args.set)
+    cfg = apply_overrides(preset(args.variant, seed=args.seed), learn_set)
+    rd = RunDir(args.out)
+    if args.resume and rd.exists("reference.npz"):
+        ref = Reference.load(rd.file("reference.npz"))
+        progress(f"learn: resuming {rd.path}")
+    elif args.reference:
+        ref = Reference.load(args.reference)
+    else:
+        motion = _motion(args)
+        progress(f"learn: retargeting {motion.source}")
+        rcfg = apply_overrides(RetargetConfig(), rt_set)
+
+        def report(gen, total, score, params):
+            progress(f"  reference search {gen}/{total}: best score {score:.3f}")
+
+        ref = do_retarget(motion, robot, rcfg, progress=report).reference
+        ref.settings["robot"] = args.robot
+        ref.settings["joint_map"] = args.joint_map
+    progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
+    summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
+    keys = (
+        "variant",
+        "scale_reached",
+        "scales_passed",
+        "iterations",
+        "sim_seconds_used_for_learning",
+        "wall_seconds_for_learning",
+    )
+    out = {k: summary[k] for k in keys}
+    out["run_dir"] = str(rd.path)
+    emit(out, args.json)
+    return 0
+
+
+def evaluate(args: argparse.Namespace) -> int:
+    from imitwalk.evaluate import evaluate_run
+    from imitwalk.robustness import robustness_grid
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    cfg = rd.read_json("config.json")
+    ref_settings = cfg.get("reference", {})
+    args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
+    robot = robot_from(args)
+    if args.perturb:
+        progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
+        out = robustness_grid(
+            rd.path, robot, args.seconds, args.seeds, workers=args.workers, progress=progress
+        )
+        rd.write_json("robustness.json", out)
+    else:
+        progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
+        out = evaluate_run(rd.path, robot, args.seconds, args.seeds, workers=args.workers)
+        rd.write_json("evaluation.json", out)
+    emit(out, args.json)
+    return 0
+
+
+#: The demo's budget: a small reference search, a short schedule, a quick evaluation.
+DEMO_RETARGET = [
+    "search_config.generations=2",
+    "search_config.population=6",
+    "search_config.seconds=10",
+]
+DEMO_LEARN = [
+    "schedule.start=0.5",
+    "schedule.iterations=2",
+    "schedule.seconds=10",
+    "train_models=2",
+]
+
+
+def demo(args: argparse.Namespace) -> int:
+    import time
+
+    from imitwalk.config import apply_overrides
+    from imitwalk.evaluate import evaluate_run
+    from imitwalk.learnconfig import preset
+    from imitwalk.learner import learn as run_learn
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.report import write_report
+    from imitwalk.retarget import RetargetConfig
+    from imitwalk.retarget import retarget as do_retarget
+    from imitwalk.robots import load_robot
+    from imitwalk.runs import RunDir
+
+    t0 = time.perf_counter()
+    out = Path(args.out)
+    robot = load_robot("hoap2")
+    rd = RunDir(out)
+    if rd.exists("checkpoint.json") and not rd.exists("metrics.json"):
+        raise_resume = True
+    else:
+        raise_resume = False
+    if rd.exists("metrics.json"):
+        progress(f"demo: {out} already holds a finished run; reusing it")
+    else:
+        motion = load_motion(default_clip())
+        progress(f"[1/4] retarget {Path(motion.source).name}: IK on the robot + parameter search")
+        cfg = apply_overrides(RetargetConfig(), DEMO_RETARGET)
+        ref = do_retarget(
+            motion,
+            robot,
+            cfg,
+            progress=lambda g, n, s, p: progress(f"      search {g}/{n}: best score {s:.3f}"),
+        ).reference
+        ref.settings["robot"] = "hoap2"
+        progress("[2/4] learn (extended variant; demo schedule 0.5 -> 1.0)")
+        lcfg = apply_overrides(preset("extended"), DEMO_LEARN)
+        run_learn(
+            ref, robot, lcfg, out, resume=raise_resume, progress=lambda s: progress("      " + s)
+        )
+    progress("[3/4] evaluate: learned vs open loop on 4 robots x 20 s")
+    ev = evaluate_run(out, robot, seconds=20.0, seeds=4)
+    rd.write_json("evaluation.json", ev)
+    progress("[4/4] report: figures, film strips, video")
+    report = write_report(out, robot, progress=lambda s: progress("      " + s))
+    wall = time.perf_counter() - t0
+    summary = {
+        "report": str(report),
+        "scale_reached": ev["learned"]["scale_reached"],
+        "learned_falls": f"{ev['learned']['falls']}/{ev['learned']['seeds']}",
+        "open_loop_falls": f"{ev['open_loop']['falls']}/{ev['open_loop']['seeds']}",
+        "learned_speed_mps": ev["learned"]["forward_speed_mps"]["mean"],
+        "wall_seconds": wall,
+    }
+    emit(summary, args.json)
+    progress(f"demo: report written to {report}")
+    return 0

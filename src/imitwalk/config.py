@@ -14,7 +14,7 @@ from typing import Any
 
 from imitwalk.errors import ConfigError, unknown_name
 
-__all__ = ["apply_overrides", "to_dict"]
+__all__ = ["apply_overrides", "from_dict", "to_dict"]
 
 
 def _coerce(text: str, current: Any, key: str) -> Any:
@@ -79,3 +79,28 @@ def apply_overrides(cfg: Any, overrides: list[str] | tuple[str, ...] | None) -> 
 def to_dict(cfg: Any) -> dict:
     """Plain-JSON dictionary of a (nested) settings dataclass."""
     return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))
+
+
+def from_dict(cls: type, data: dict) -> Any:
+    """Rebuild a (nested) settings dataclass from :func:`to_dict` output."""
+    kwargs = {}
+    hints = {f.name: f for f in dataclasses.fields(cls)}
+    for name, value in data.items():
+        if name not in hints:
+            continue
+        default = getattr(cls(), name) if _has_defaults(cls) else None
+        if dataclasses.is_dataclass(default) and isinstance(value, dict):
+            kwargs[name] = from_dict(type(default), value)
+        elif isinstance(default, tuple) and isinstance(value, list):
+            kwargs[name] = tuple(value)
+        else:
+            kwargs[name] = value
+    return cls(**kwargs)
+
+
+def _has_defaults(cls: type) -> bool:
+    try:
+        cls()
+    except TypeError:
+        return False
+    return True

@@ -65,6 +65,9 @@ class SensoryMotorModel(BaseEstimator):
         order: n of eq. (3); 2 (the paper) or 1 (s_{t−1}, a_{t−1} ignored).
         n_centers, width, ridge, random_state: of the :class:`~imitwalk.rbf.RBFNetwork`.
         predict_delta: learn s_{t+1} − s_t instead of s_{t+1} (same F).
+        angle_action: the action's first component is the angle φ, encoded (cos φ, sin φ);
+            False for actions without an angle (e.g. the step-level balance channels).
+        linear: add linear terms in α to the network (beside the kernels of eq. 4).
 
     Attributes (after :meth:`fit`):
         network_: the fitted :class:`~imitwalk.rbf.RBFNetwork` on α = [s_t, s_{t−1},
@@ -80,8 +83,12 @@ class SensoryMotorModel(BaseEstimator):
         ridge: float = 1e-3,
         predict_delta: bool = True,
         random_state: int | None = 0,
+        angle_action: bool = True,
+        linear: bool = False,
     ):
         self.order = order
+        self.angle_action = angle_action
+        self.linear = linear
         self.n_centers = n_centers
         self.width = width
         self.ridge = ridge
@@ -114,9 +121,10 @@ class SensoryMotorModel(BaseEstimator):
 
     def _alpha(self, s_t, s_tm1, a_t, a_tm1) -> np.ndarray:
         """Network input α, eq. (4): ``(M, 2 ds + 2 (da + 1))`` (order 1: half of it)."""
+        enc = encode_action if self.angle_action else (lambda a: np.asarray(a, dtype=float))
         if self.order == 1:
-            return np.concatenate([s_t, encode_action(a_t)], axis=-1)
-        return np.concatenate([s_t, s_tm1, encode_action(a_t), encode_action(a_tm1)], axis=-1)
+            return np.concatenate([s_t, enc(a_t)], axis=-1)
+        return np.concatenate([s_t, s_tm1, enc(a_t), enc(a_tm1)], axis=-1)
 
     def fit(self, episodes: Sequence[Episode]) -> SensoryMotorModel:
         """Fit F on recorded episodes.
@@ -131,6 +139,7 @@ class SensoryMotorModel(BaseEstimator):
             n_centers=self.n_centers,
             width=self.width,
             ridge=self.ridge,
+            linear=self.linear,
             random_state=self.random_state,
         ).fit(alpha, target)
         self.n_state_, self.n_action_ = dims

@@ -19,7 +19,10 @@ from imitwalk.errors import RetargetError
 from imitwalk.retarget.plan import LegGeometry, TaskPlan
 from imitwalk.robots import Robot
 
-__all__ = ["IKResult", "WalkIK", "leg_geometry"]
+__all__ = ["CHANNELS", "IKResult", "WalkIK", "leg_geometry"]
+
+#: Task-space offsets the IK can add to a plan's targets (see :meth:`WalkIK.solve_tick`).
+CHANNELS = ("l_x", "l_y", "l_yaw", "r_x", "r_y", "r_yaw", "com_y", "com_x")
 
 
 def _frame(model: mujoco.MjModel, name: str) -> tuple[str, int]:
@@ -140,6 +143,50 @@ class WalkIK:
         self.posture = mink.PostureTask(m, cost=cost)
         self.limits = [mink.ConfigurationLimit(m)]
 
+    def _targets(self, plan: TaskPlan, i: int, base: np.ndarray, offset: np.ndarray) -> None:
+        """Set every task's target for tick ``i``; ``offset`` is ``(8,)`` in :data:`CHANNELS`."""
+        r, cfg = self.robot, self.cfg
+        target_q = cfg.q.copy()
+        for role, val in plan.upper.items():
+            if role in r.joint_names:
+                j = r.index(role)
+                target_q[self._qadr[j]] = (base[j] + val[i]) * r.signs[j]
+        self.posture.set_target(target_q)
+        for k, (s, sole) in enumerate((("l", plan.l_sole), ("r", plan.r_sole))):
+            dx, dy, dyaw = offset[3 * k : 3 * k + 3]
+            c, sn = np.cos(dyaw), np.sin(dyaw)
+            pose = np.eye(4)
+            pose[:3, :3] = (
+                np.array([[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]]) @ self._sole_rot[s]
+            )
+            pose[:3, 3] = sole[i] + np.array([dx, dy, 0.0])
+            self.tasks[s].set_target(mink.SE3.from_matrix(pose))
+        com = plan.com[i] + np.array([offset[7], offset[6]])
+        self.com.set_target(np.array([com[0], com[1], 0.0]))
+        self.pelvis.set_target(mink.SE3.from_translation(np.array([0.0, 0.0, plan.pelvis_z[i]])))
+
+    def _converge(self, max_iter: int) -> int:
+        tasks = [self.tasks["l"], self.tasks["r"], self.com, self.pelvis, self.posture]
+        for it in range(max_iter):
+            v = mink.solve_ik(self.cfg, tasks, 1.0, "daqp", damping=1e-8, limits=self.limits)
+            self.cfg.integrate_inplace(v, 1.0)
+            if np.abs(v).max() < self.tol:
+                return it + 1
+        return max_iter
+
+    def start(self, qpos: np.ndarray) -> None:
+        """Warm-start the solver from a whole-body state ``(nq,)``."""
+        self.cfg.update(np.asarray(qpos, dtype=float).copy())
+
+    def solve_tick(
+        self, plan: TaskPlan, i: int, offset: np.ndarray, max_iter: int = 10
+    ) -> np.ndarray:
+        """Joint angles ``(n,)`` [rad] for tick ``i`` of ``plan`` with task ``offset`` ``(8,)``
+        (:data:`CHANNELS`), warm-started from the previous call."""
+        self._targets(plan, i, self.robot.stand, np.asarray(offset, dtype=float))
+        self._converge(max_iter)
+        return self.cfg.q[self._qadr] * self.robot.signs
+
     def solve(self, plan: TaskPlan, q_upper_base: np.ndarray | None = None) -> IKResult:
         """Solve every tick of ``plan``.
 
@@ -154,29 +201,10 @@ class WalkIK:
         n = len(plan.phase)
         out_q, out_qpos = np.zeros((n, r.dof)), np.zeros((n, m.nq))
         res, drop, iters = np.zeros(n), np.zeros(n), np.zeros(n, dtype=int)
-        tasks = [self.tasks["l"], self.tasks["r"], self.com, self.pelvis, self.posture]
+        zero = np.zeros(len(CHANNELS))
         for i in range(n):
-            target_q = cfg.q.copy()
-            for role, val in plan.upper.items():
-                if role in r.joint_names:
-                    j = r.index(role)
-                    target_q[self._qadr[j]] = (base[j] + val[i]) * r.signs[j]
-            self.posture.set_target(target_q)
-            for s, sole in (("l", plan.l_sole), ("r", plan.r_sole)):
-                pose = np.eye(4)
-                pose[:3, :3] = self._sole_rot[s]
-                pose[:3, 3] = sole[i]
-                self.tasks[s].set_target(mink.SE3.from_matrix(pose))
-            self.com.set_target(np.array([plan.com[i, 0], plan.com[i, 1], 0.0]))
-            self.pelvis.set_target(
-                mink.SE3.from_translation(np.array([0.0, 0.0, plan.pelvis_z[i]]))
-            )
-            for it in range(self.max_iter):
-                v = mink.solve_ik(cfg, tasks, 1.0, "daqp", damping=1e-8, limits=self.limits)
-                cfg.integrate_inplace(v, 1.0)
-                iters[i] = it + 1
-                if np.abs(v).max() < self.tol:
-                    break
+            self._targets(plan, i, base, zero)
+            iters[i] = self._converge(self.max_iter)
             d = cfg.data
             errs = [
                 np.linalg.norm(_pos(m, d, r.soles["l"]) - plan.l_sole[i]),

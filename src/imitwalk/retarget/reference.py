@@ -18,7 +18,23 @@ import numpy as np
 
 from imitwalk.errors import RunError
 
-__all__ = ["Reference", "atomic_write"]
+__all__ = ["PLAN_KEYS", "Reference", "atomic_write", "plan_arrays"]
+
+#: Arrays of a stored task-space plan (upper-body roles in :data:`UPPER`).
+PLAN_KEYS = ("l_sole", "r_sole", "com", "pelvis_z", "upper")
+UPPER = ("l_shoulder_pitch", "r_shoulder_pitch", "l_elbow", "r_elbow", "waist_yaw")
+
+
+def plan_arrays(plan) -> dict[str, np.ndarray]:
+    """A :class:`~imitwalk.retarget.plan.TaskPlan` as the arrays a reference stores."""
+    upper = np.stack([plan.upper.get(u, np.zeros(len(plan.phase))) for u in UPPER], axis=1)
+    return {
+        "l_sole": plan.l_sole,
+        "r_sole": plan.r_sole,
+        "com": plan.com,
+        "pelvis_z": plan.pelvis_z,
+        "upper": upper,
+    }
 
 
 def atomic_write(path: str | Path, write) -> Path:
@@ -57,6 +73,9 @@ class Reference:
         params: the reference parameters; search: the report of the search for them.
         source: the mocap file; settings: how it was retargeted; cycles: ``(C, 2)``
             source frames of the gait cycles used.
+        plan: the task-space plan the walkable IK solved, per scale and tick of the
+            start-up and loop (``(S, M + N, ...)`` arrays named by :data:`PLAN_KEYS`);
+            empty for the paper's mapping. The balance channels re-solve it with offsets.
     """
 
     robot: str
@@ -79,6 +98,7 @@ class Reference:
     source: str = ""
     settings: dict = field(default_factory=dict)
     cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    plan: dict = field(default_factory=dict)
 
     # -- access ---------------------------------------------------------------
     def _bracket(self, scale: float) -> tuple[int, int, float]:
@@ -99,6 +119,14 @@ class Reference:
         i, j, w = self._bracket(scale)
         mix = lambda a: (1.0 - w) * a[i] + w * a[j]  # noqa: E731
         return mix(self.starts), mix(self.loops), float(mix(self.strides))
+
+    def plan_at(self, scale: float) -> dict[str, np.ndarray]:
+        """The task-space plan ``(M + N, ...)`` arrays at ``scale`` (blended between grid
+        scales, as :meth:`at_scale` blends the joint angles)."""
+        if not self.plan:
+            raise RunError("this reference has no task-space plan (the paper's mapping?)")
+        i, j, w = self._bracket(scale)
+        return {k: (1.0 - w) * v[i] + w * v[j] for k, v in self.plan.items()}
 
     def trajectory(self, scale: float, seconds: float) -> np.ndarray:
         """``(T, n)`` joint targets for ``seconds``: the start-up, then the loop repeated."""
@@ -128,7 +156,9 @@ class Reference:
         meta = {}
         for f in fields(self):
             v = getattr(self, f.name)
-            if isinstance(v, np.ndarray):
+            if f.name == "plan":
+                arrays.update({f"plan_{k}": a for k, a in v.items()})
+            elif isinstance(v, np.ndarray):
                 arrays[f.name] = v
             else:
                 meta[f.name] = v
@@ -151,10 +181,13 @@ class Reference:
             with np.load(path, allow_pickle=False) as z:
                 meta = json.loads(str(z["meta_json"]))
                 arrays = {k: z[k] for k in z.files if k not in ("meta_json", "q")}
+            plan = {k[5:]: arrays.pop(k) for k in list(arrays) if k.startswith("plan_")}
         except (OSError, ValueError, KeyError) as exc:
             raise RunError(f"{path} is not an imitwalk reference: {exc}") from None
         meta["joint_names"] = tuple(meta["joint_names"])
-        return cls(**meta, **arrays)
+        known = {f.name for f in fields(cls)}
+        arrays = {k: v for k, v in arrays.items() if k in known}
+        return cls(**{k: v for k, v in meta.items() if k in known}, **arrays, plan=plan)
 
     def summary(self) -> dict:
         """Plain-JSON description (no per-tick arrays)."""

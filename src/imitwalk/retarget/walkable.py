@@ -15,7 +15,7 @@ import numpy as np
 from imitwalk.retarget.checks import kinematic_checks
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.plan import GaitParams, plan_walk
-from imitwalk.retarget.reference import Reference
+from imitwalk.retarget.reference import PLAN_KEYS, Reference, plan_arrays
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.robots import Robot
 
@@ -53,6 +53,7 @@ def build_walkable(
     geom = leg_geometry(robot)
     scales = np.asarray(sorted(scales), dtype=float)
     starts, loops, strides, resid, clipped, travel = [], [], [], [], [], []
+    plans: dict[str, list] = {k: [] for k in PLAN_KEYS}
     t0 = time.perf_counter()
     frames = 0
     check_i = int(np.argmin(np.abs(scales - check_scale)))
@@ -70,6 +71,8 @@ def build_walkable(
         loops.append(res.q[m:])
         strides.append(plan.stride)
         travel.append(plan.com[:m, 0] - plan.com[0, 0])
+        for key, val in plan_arrays(plan).items():
+            plans[key].append(val)
         resid.append(res.residual_mm)
         for j in np.flatnonzero(res.at_limit.any(axis=0)):
             clipped.append(
@@ -106,5 +109,6 @@ def build_walkable(
         clipped=clipped,
         checks=checks,
         params=params.to_dict(),
+        plan={k: np.stack(v) for k, v in plans.items()},
     )
     return WalkableBuild(ref, frames, elapsed)

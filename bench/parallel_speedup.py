@@ -1,0 +1,76 @@
+"""Batch evaluation on 2 cores: ``mujoco.rollout`` with 1 and 2 threads, and imitwalk's
+process pool with 1 and 2 workers, on the same open-loop playbacks (same run).
+
+Usage: ``python bench/parallel_speedup.py [--models 8] [--seconds 10]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from imitwalk.mocap import default_clip, load_motion
+from imitwalk.parallel import run_parallel
+from imitwalk.perturb import perturbed
+from imitwalk.playback import play_reference
+from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.robots import load_robot
+from imitwalk.sim import MujocoPlant
+
+
+def _models(robot, n: int):
+    """Perturbed MjModels (built by the Plant) and each one's per-physics-step controls."""
+    models = []
+    for s in range(n):
+        p = MujocoPlant(robot, perturbed(s))
+        p.reset()
+        models.append(p)
+    return models
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--models", type=int, default=8)
+    ap.add_argument("--seconds", type=float, default=10.0)
+    args = ap.parse_args()
+    robot = load_robot("hoap2")
+    cfg = RetargetConfig(search=False, scales=(0.5,), params=GaitParams())
+    ref = retarget(load_motion(default_clip()), robot, cfg).reference
+    q = ref.trajectory(0.5, args.seconds)
+    plants = _models(robot, args.models)
+    sub = plants[0].options.substeps
+    nstep = len(q) * sub
+    ctrl = np.zeros((args.models, nstep, plants[0].model.nu))
+    states = []
+    for i, p in enumerate(plants):
+        act = p._act
+        ctrl[i][:, act] = np.repeat(q * robot.signs, sub, axis=0)
+        full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        st = np.empty(mujoco.mj_stateSize(p.model, full))
+        mujoco.mj_getState(p.model, p.data, st, full)
+        states.append(st)
+    models = [p.model for p in plants]
+    out = {"models": args.models, "sim_seconds_each": args.seconds}
+    for threads in (1, 2):
+        datas = [mujoco.MjData(models[0]) for _ in range(threads)]
+        t = time.perf_counter()
+        rollout.rollout(models, datas, np.array(states), ctrl, persistent_pool=False)
+        out[f"rollout_{threads}_threads_s"] = round(time.perf_counter() - t, 3)
+    out["rollout_speedup"] = round(out["rollout_1_threads_s"] / out["rollout_2_threads_s"], 2)
+    for workers in (1, 2):
+        t = time.perf_counter()
+        play_reference(ref, robot, 0.5, args.seconds, list(range(args.models)), workers=workers)
+        out[f"pool_{workers}_workers_s"] = round(time.perf_counter() - t, 3)
+    out["pool_speedup"] = round(out["pool_1_workers_s"] / out["pool_2_workers_s"], 2)
+    print(json.dumps(out, indent=2))
+
+
+_ = run_parallel
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,227 @@
+"""Balance channels beside the posture subspace, decided once per step (pure NumPy).
+
+The paper's action (φ, r, h) moves stride and sway together. These channels give the
+learner its own handles on balance, decided at each step boundary (heel strike) by the
+paper's machinery one level up: a 2nd-order sensory-motor model of *step* states
+F(s_k, s_{k−1}, c_k, c_{k−1}) → s_{k+1} (an RBF network, eqs. 3–4) and a predictive
+search over a box of candidate channel values (eqs. 5–7), over a horizon of steps.
+
+Channels (mirrored so that one model serves left and right steps):
+
+* ``dx``: the swing foot lands further forward [m];
+* ``dy``: the swing foot lands further out, away from the stance foot [m];
+* ``yaw``: the swing foot lands turned [rad] (the body follows it during the next stance);
+* ``sway``: an extra lateral shift of the centre of mass towards the stance foot [m];
+* ``lean``: the centre of mass further forward over the feet [m], held from step to step
+  (it moves linearly from the previous step's value to this step's over the step).
+
+They act in task space: the landing offsets grow smoothly over the swing and decay over
+the foot's next stance, the sway is a half-sine bump over the step; the robot's IK
+re-solves the reference's task-space plan with these offsets
+(:class:`imitwalk.retarget.online.OnlineIK`). The step state (mirrored) is torso roll,
+pitch, heading, the mean gyro over the step, the stance foot's share of the load and the
+mean front/rear balance of the sole forces over the step — all from the robot's own
+sensors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.controller import stability_cost
+from imitwalk.predictor import SensoryMotorModel
+
+__all__ = [
+    "STEP_CHANNELS",
+    "STEP_STATE",
+    "StepConfig",
+    "StepController",
+    "mirror_state",
+    "step_target",
+]
+
+STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean")
+#: Step state, in the stance side's mirrored frame.
+STEP_STATE = (
+    "roll",
+    "pitch",
+    "heading",
+    "roll_rate",
+    "pitch_rate",
+    "yaw_rate",
+    "stance_load",
+    "cop_x",
+)
+_LATERAL = np.array([1, 0, 1, 1, 0, 1, 0, 0], dtype=bool)  # flip sign when mirrored
+
+
+@dataclass(frozen=True)
+class StepConfig:
+    """Step-level channel learning.
+
+    Attributes:
+        channels: which of :data:`STEP_CHANNELS` the learner may use.
+        c_max: box half-width per channel in :data:`STEP_CHANNELS` order [m, m, rad, m, m].
+        weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
+            on the deviation from the target state (the walk's own mean state, heading 0).
+        effort: weight of Σ (c / c_max)² in the objective.
+        horizon: steps predicted ahead (later steps take the nominal, zero, channels).
+        candidates: random candidates per decision (plus the nominal zero).
+        explore: exploration noise, a fraction of c_max, in the first iteration at a scale.
+        n_centers, ridge: of the step model's RBF network (which also has linear terms).
+    """
+
+    channels: tuple[str, ...] = STEP_CHANNELS
+    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01)
+    weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
+    effort: float = 0.05
+    horizon: int = 2
+    candidates: int = 256
+    explore: float = 0.3
+    n_centers: int = 24
+    ridge: float = 1e-2
+
+
+def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: float) -> np.ndarray:
+    """The state the step objective aims for: the mean recorded (mirrored) step state of
+    steps taken at scales within 0.1 of ``scale`` (all steps if none), heading 0.
+
+    A walking robot's torso never settles at zero tilt; aiming for zero would make the
+    search fight the gait itself. Heading is the exception: the walk should go straight.
+    """
+    if not states:
+        return np.zeros(len(STEP_STATE))
+    S = np.vstack(states)
+    A = np.vstack(actions)
+    near = np.abs(A[:, -1] - scale) <= 0.1 + 1e-9
+    out = (S[near] if near.any() else S).mean(axis=0)
+    out[2] = 0.0
+    return out
+
+
+def mirror_state(s: np.ndarray, m: float) -> np.ndarray:
+    """A step state seen from the stance side: lateral parts × m (+1 left, −1 right).
+
+    The last entry (``load_left`` raw) becomes the stance foot's share.
+    """
+    out = np.array(s, dtype=float)
+    out[..., _LATERAL] *= m
+    if m < 0:
+        out[..., 6] = 1.0 - out[..., 6]
+    return out
+
+
+class StepController:
+    """Decides the channel values of each step and turns them into task offsets.
+
+    Args:
+        config: settings; n_ticks: ticks per gait cycle N; ds: double-support fraction.
+        model: a fitted step model (``None``: nominal channels, plus exploration).
+        rng: exploration noise source (``None``: no exploration).
+        explore: noise amplitude, a fraction of ``c_max``; scale: the stride scale (an
+            input of the step model); target: ``(8,)`` mirrored step state the objective
+            pulls towards (see :func:`step_target`).
+    """
+
+    def __init__(
+        self,
+        config: StepConfig,
+        n_ticks: int,
+        ds: float,
+        model: SensoryMotorModel | None = None,
+        rng: np.random.Generator | None = None,
+        explore: float = 0.0,
+        scale: float = 1.0,
+        target: np.ndarray | None = None,
+    ):
+        self.config, self.n, self.ds, self.scale = config, n_ticks, ds, scale
+        self.target = np.zeros(len(STEP_STATE)) if target is None else np.asarray(target, float)
+        self.model, self.rng, self.explore = model, rng, explore
+        self.mask = np.array([c in config.channels for c in STEP_CHANNELS], dtype=float)
+        self.c_max = np.asarray(config.c_max, dtype=float) * self.mask
+        self.states: list[np.ndarray] = []  # mirrored step states s_k
+        self.actions: list[np.ndarray] = []  # channel values c_k (mirrored coordinates)
+        self.predicted: list[float] = []
+        self._land = {0: np.zeros(3), 1: np.zeros(3)}  # landing offsets (x, y, yaw) per foot
+        self._last_k = -1
+
+    # -- decisions ------------------------------------------------------------
+    def decide(self, state_raw: np.ndarray, k: int) -> np.ndarray:
+        """Channel values for step ``k`` given the raw step state at its start."""
+        m = 1.0 if k % 2 == 0 else -1.0  # even steps: left stance (ψ ∈ [0, ½))
+        s = mirror_state(state_raw, m)
+        self.states.append(s)
+        c = np.zeros(len(STEP_CHANNELS))
+        if self.model is not None and len(self.states) >= 2 and len(self.actions) >= 1:
+            c, pred = self._search(s, self.states[-2], np.r_[self.actions[-1], self.scale])
+            self.predicted.append(pred)
+        if self.rng is not None and self.explore > 0:
+            c = c + self.explore * self.c_max * self.rng.uniform(-1.0, 1.0, len(c))
+        c = np.clip(c, -self.c_max, self.c_max)
+        self.actions.append(c)
+        return c
+
+    def _search(self, s, s_prev, c_prev) -> tuple[np.ndarray, float]:
+        cfg = self.config
+        rng = np.random.default_rng(len(self.states))
+        cand = self.c_max * rng.uniform(-1.0, 1.0, (cfg.candidates, len(STEP_CHANNELS)))
+        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, 4)
+        seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
+        seq[:, 0, :-1] = cand
+        seq[:, :, -1] = self.scale  # the model also sees the stride scale
+        pred = self.model.rollout(s, s_prev, seq, c_prev)  # (M, H, ds)
+        w = np.asarray(cfg.weights, dtype=float)
+        scale = np.where(self.c_max > 0, self.c_max, 1.0)
+        dev = pred - self.target
+        cost = stability_cost(dev, w).sum(axis=1) + cfg.effort * np.sum((cand / scale) ** 2, 1)
+        best = int(np.argmin(cost))
+        return cand[best], float(cost[best])
+
+    # -- task offsets ---------------------------------------------------------
+    def episode(self) -> tuple[np.ndarray, np.ndarray]:
+        """The recorded steps for training: states ``(K, 7)`` and actions ``(K, 5)``
+        (channels and the scale)."""
+        k = min(len(self.states), len(self.actions))
+        acts = np.c_[np.asarray(self.actions[:k]).reshape(k, -1), np.full(k, self.scale)]
+        return np.asarray(self.states[:k]).reshape(k, -1), acts
+
+    def offsets(self, i: int) -> np.ndarray:
+        """``(8,)`` task offsets at loop tick ``i`` (≥ 0), in ``retarget.ik.CHANNELS`` order.
+
+        Call :meth:`decide` for step ``k = i // (N/2)`` before its first tick.
+        """
+        half = self.n / 2.0
+        k = int(i // half)
+        for done in range(max(self._last_k, 0), k):  # steps finished since the last call:
+            self._land[1 - done % 2] = self._landing(done)  # their swing feet have landed
+        self._last_k = max(self._last_k, k)
+        u = (i - k * half) / half  # progress through the step, 0 → 1
+        stance, swing = (0, 1) if k % 2 == 0 else (1, 0)
+        m = 1.0 if stance == 0 else -1.0
+        c = self.actions[k] if k < len(self.actions) else np.zeros(len(STEP_CHANNELS))
+        out = np.zeros(8)
+        # the stance foot's landing offset (from the previous step) decays over this step
+        decay = 1.0 - _smooth(u)
+        out[3 * stance : 3 * stance + 3] = self._land[stance] * decay
+        # the swing foot grows its landing offset over its swing window [ds, 1) of the step
+        sigma = np.clip((u - 2 * self.ds) / (1.0 - 2 * self.ds), 0.0, 1.0)
+        out[3 * swing : 3 * swing + 3] = self._landing(k) * _smooth(sigma)
+        out[6] = m * c[3] * np.sin(np.pi * u)
+        prev = self.actions[k - 1][4] if 0 < k <= len(self.actions) else 0.0
+        out[7] = prev + (c[4] - prev) * u
+        return out
+
+    def _landing(self, k: int) -> np.ndarray:
+        """World-frame landing offset (x, y, yaw) of step ``k``'s swing foot."""
+        if k >= len(self.actions):
+            return np.zeros(3)
+        c = self.actions[k]
+        m = 1.0 if k % 2 == 0 else -1.0
+        return np.array([c[0], -m * c[1], m * c[2]])
+
+
+def _smooth(x: float) -> float:
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)

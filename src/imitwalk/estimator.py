@@ -1,0 +1,86 @@
+"""What the robot can know about itself from its own sensors (pure NumPy).
+
+A real HOAP-2 has a torso gyro and accelerometer, four force sensors under each sole
+and joint encoders; nothing else. :class:`StateEstimator` turns those readings into the
+learner's state: torso roll and pitch from a complementary filter (gyro integrated,
+pulled towards the accelerometer's gravity direction with time constant ``tau``),
+heading from the integrated yaw rate, how the load is shared between the feet, and
+where it sits under them (the centre of pressure, from four sensors per sole laid out
+front-left, front-right, rear-left, rear-right). No simulator ground truth is used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["STATE_NAMES", "Estimate", "StateEstimator"]
+
+#: The full state vector, in order.
+STATE_NAMES = ("gyro_x", "gyro_y", "gyro_z", "roll", "pitch", "heading", "load_left", "cop_x")
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One tick's estimate.
+
+    Attributes:
+        gyro: ``(3,)`` torso angular velocity [rad/s]; roll, pitch: torso tilt [rad];
+        heading: integrated yaw since reset [rad]; load_left: share of the sole forces
+        under the left foot (0.5 when nothing touches); cop_x: front minus rear sensor
+        force over the total, −1 (all on the heels) … 1 (all on the toes), 0 if unknown.
+    """
+
+    gyro: np.ndarray
+    roll: float
+    pitch: float
+    heading: float
+    load_left: float
+    cop_x: float = 0.0
+
+    def vector(self) -> np.ndarray:
+        """``(8,)`` in :data:`STATE_NAMES` order."""
+        return np.array(
+            [*self.gyro, self.roll, self.pitch, self.heading, self.load_left, self.cop_x]
+        )
+
+
+class StateEstimator:
+    """Complementary-filter tilt, integrated heading, foot-load share.
+
+    Args:
+        dt: control period [s]; tau: time constant pulling the tilt towards the
+            accelerometer [s] (long: trust the gyro; short: trust the accelerometer).
+    """
+
+    def __init__(self, dt: float, tau: float = 0.5):
+        self.dt, self.tau = dt, tau
+        self.reset()
+
+    def reset(self) -> None:
+        """Level, heading zero."""
+        self.roll = self.pitch = self.heading = 0.0
+        self._started = False
+
+    def update(self, gyro: np.ndarray, accel: np.ndarray, foot_force: np.ndarray) -> Estimate:
+        """Fold in one tick of readings: gyro ``(3,)`` [rad/s], accel ``(3,)`` [m/s²],
+        foot_force ``(2, k)`` [N]."""
+        gyro = np.asarray(gyro, dtype=float)
+        ax, ay, az = np.asarray(accel, dtype=float)
+        acc_roll = float(np.arctan2(ay, az))
+        acc_pitch = float(np.arctan2(-ax, np.hypot(ay, az)))
+        if not self._started or not np.isfinite(acc_roll):
+            self.roll, self.pitch, self._started = acc_roll, acc_pitch, True
+        else:
+            a = self.tau / (self.tau + self.dt)
+            self.roll = a * (self.roll + gyro[0] * self.dt) + (1 - a) * acc_roll
+            self.pitch = a * (self.pitch + gyro[1] * self.dt) + (1 - a) * acc_pitch
+        self.heading += float(gyro[2]) * self.dt
+        f = np.asarray(foot_force, dtype=float)
+        total = f.sum()
+        load = float(f[0].sum() / total) if total > 1e-6 else 0.5
+        cop = 0.0
+        if f.shape[1] == 4 and total > 1e-6:
+            cop = float((f[:, :2].sum() - f[:, 2:].sum()) / total)
+        return Estimate(gyro.copy(), self.roll, self.pitch, self.heading, load, cop)

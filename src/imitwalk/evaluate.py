@@ -1,0 +1,153 @@
+"""Judging a learned run: the learned controller beside open-loop playback, same robots.
+
+Seed 0 is the nominal robot; every other seed is perturbed (masses ±5 %, friction
+0.7–1.0, servo stiffness ±10 %) and starts with a small random push of the base
+(:func:`imitwalk.perturb.perturbed` with ``disturbance=True``). Learning never sees
+these seeds. Both controllers start from the standing pose at the scale the run
+reached and are judged by the same :func:`~imitwalk.metrics.walk_metrics`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from imitwalk.gait import GaitModel
+from imitwalk.learnconfig import LearnConfig
+from imitwalk.metrics import summarise, walk_metrics
+from imitwalk.models import build_policy, fit_models, unstack_episodes
+from imitwalk.parallel import run_parallel
+from imitwalk.perturb import perturbed
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+from imitwalk.sim import MujocoPlant, SimOptions, playback, run
+
+__all__ = ["LearnedGait", "evaluate_run", "load_gait", "per_seed"]
+
+KEYS = (
+    "forward_distance_m",
+    "forward_speed_mps",
+    "progress_ratio",
+    "lateral_drift_m",
+    "yaw_drift_deg",
+    "gyro_rms",
+    "joint_rms_error_rad",
+    "max_tilt_deg",
+)
+
+
+class LearnedGait:
+    """Everything needed to replay a run's learned controller (rebuilt from its folder)."""
+
+    def __init__(self, ref: Reference, config: LearnConfig, data: dict, metrics: dict):
+        self.ref, self.config, self.metrics = ref, config, metrics
+        self.scale = float(metrics["scale_reached"]) or config.schedule.start
+        self.gait = GaitModel(ref, config.schedule.scales(), config.gait)
+        self.models = fit_models(data, config)
+
+    def policy(self, robot: Robot, scale: float | None = None):
+        """A fresh controller (no exploration) at ``scale`` (default: the scale reached)."""
+        s = self.scale if scale is None else scale
+        return build_policy(self.gait, s, self.config, self.models, robot=robot)
+
+
+def load_gait(run_dir) -> LearnedGait:
+    """Rebuild the learned controller of a finished run folder."""
+    from imitwalk.config import from_dict
+
+    rd = RunDir(run_dir)
+    metrics = rd.read_json("metrics.json")
+    cfg = from_dict(LearnConfig, rd.read_json("config.json")["learn"])
+    data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else {}
+    return LearnedGait(Reference.load(rd.file("reference.npz")), cfg, data, metrics)
+
+
+_CACHE: dict = {}
+
+
+def _one(job) -> dict:
+    run_dir, robot, mode, seed, seconds, base, scale = job
+    key = str(run_dir)
+    if key not in _CACHE:
+        _CACHE.clear()
+        _CACHE[key] = load_gait(run_dir)
+    lg = _CACHE[key]
+    scale = lg.scale if scale is None else scale
+    opts = perturbed(seed, base, disturbance=seed != 0)
+    steps = round(seconds / lg.ref.dt)
+    q_ref = lg.ref.trajectory(scale, seconds)
+    if mode == "learned":
+        ro = run(MujocoPlant(robot, opts), lg.policy(robot, scale), steps)
+    else:
+        ro = playback(MujocoPlant(robot, opts), q_ref, q0=q_ref[0])
+    m = walk_metrics(ro, lg.ref.expected_distance(scale, ro.seconds), q_ref)
+    out = m.to_dict()
+    out["seed"] = seed
+    out["cycle_period_s"] = lg.ref.period
+    return out
+
+
+def per_seed(
+    run_dir,
+    robot: Robot,
+    seconds: float,
+    seeds,
+    base: SimOptions | None = None,
+    workers=None,
+    modes=("learned", "open_loop"),
+    scale=None,
+) -> dict[str, list[dict]]:
+    """Per-seed metrics of each mode."""
+    jobs = [(str(run_dir), robot, mode, s, seconds, base, scale) for mode in modes for s in seeds]
+    res = run_parallel(_one, jobs, workers)
+    return {mode: [r for r, j in zip(res, jobs, strict=True) if j[2] == mode] for mode in modes}
+
+
+def _summary(runs: list[dict], metrics: dict) -> dict:
+    out = {"falls": int(sum(r["fell"] for r in runs)), "seeds": len(runs)}
+    for k in KEYS:
+        out[k] = summarise([r[k] for r in runs])
+    out["cycle_period_s"] = runs[0]["cycle_period_s"] if runs else None
+    out["scale_reached"] = metrics.get("scale_reached")
+    for k in ("sim_seconds_used_for_learning", "wall_seconds_for_learning", "iterations"):
+        out[k] = metrics.get(k)
+    out["per_seed"] = [
+        {
+            k: r[k]
+            for k in (
+                "seed",
+                "fell",
+                "fall_time_s",
+                "progress_ratio",
+                "yaw_drift_deg",
+                "forward_speed_mps",
+            )
+        }
+        for r in runs
+    ]
+    return out
+
+
+def evaluate_run(
+    run_dir,
+    robot: Robot,
+    seconds: float = 30.0,
+    seeds: int = 10,
+    workers=None,
+    base: SimOptions | None = None,
+) -> dict:
+    """``{"learned": ..., "open_loop": ...}`` with the same keys (per-seed figures as
+    ``{"mean", "min", "max"}``); open loop is the reference at the same scale."""
+    metrics = RunDir(run_dir).read_json("metrics.json")
+    res = per_seed(run_dir, robot, seconds, list(range(seeds)), base, workers)
+    out = {mode: _summary(runs, metrics) for mode, runs in res.items()}
+    out["open_loop"]["sim_seconds_used_for_learning"] = 0.0
+    out["open_loop"]["wall_seconds_for_learning"] = 0.0
+    out["open_loop"]["iterations"] = 0
+    out["settings"] = {"seconds": seconds, "seeds": seeds, "scale": metrics.get("scale_reached")}
+    return out
+
+
+_ = (np, replace)

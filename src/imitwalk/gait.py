@@ -1,0 +1,123 @@
+"""The reference gait in the paper's representation (§3): PCA subspace + cylindrical loop.
+
+:class:`GaitModel` fits one :class:`~imitwalk.subspace.PostureSubspace` on the reference
+loops of every scale of a schedule (so one subspace serves the whole schedule), and one
+:class:`~imitwalk.embedding.GaitEmbedding` per scale. An action χ = (φ, r, h) maps to
+joint targets through g and C⁺; the nominal action sequence of a scale is its reference
+loop in cylindrical coordinates. Pure NumPy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.embedding import GaitEmbedding
+from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.retarget.reference import Reference
+from imitwalk.subspace import PostureSubspace
+
+__all__ = ["GaitConfig", "GaitModel"]
+
+PHASE_SOURCES = ("angle", "time")
+
+
+@dataclass(frozen=True)
+class GaitConfig:
+    """Representation settings.
+
+    Attributes:
+        n_components: k, the subspace size (the paper: 3; its 2009 follow-up found 3 too
+            few for some motions; beyond 3 the components follow the phase).
+        phase_source: ``"angle"`` (the paper's φ, the data's angle about z_θ) or ``"time"``
+            (the reference's time phase, robust where the angle runs backwards).
+        n_centers: kernels of the periodic fit g(φ) (eq. 2).
+    """
+
+    n_components: int = 3
+    phase_source: str = "angle"
+    n_centers: int = 24
+
+
+class GaitModel:
+    """Subspace and per-scale embeddings of a reference.
+
+    Args:
+        ref: the reference; scales: the schedule's scales; config: representation.
+    """
+
+    def __init__(self, ref: Reference, scales: list[float] | tuple[float, ...], config: GaitConfig):
+        if config.phase_source not in PHASE_SOURCES:
+            raise unknown_name("phase source", config.phase_source, PHASE_SOURCES, ConfigError)
+        if not 3 <= config.n_components <= len(ref.joint_names):
+            raise ConfigError(
+                f"n_components must be 3..{len(ref.joint_names)}, got {config.n_components}"
+            )
+        self.ref, self.config = ref, config
+        self.scales = tuple(float(s) for s in scales)
+        loops = [ref.at_scale(s)[1] for s in self.scales]
+        self.subspace = PostureSubspace(config.n_components).fit(loops)
+        self.embeddings: dict[float, GaitEmbedding] = {}
+        self.nominal: dict[float, np.ndarray] = {}
+        for s, loop in zip(self.scales, loops, strict=True):
+            X = self.subspace.transform(loop)  # (N, k)
+            emb = GaitEmbedding(n_centers=config.n_centers, phase_source=config.phase_source)
+            emb.fit(X, phase=ref.phase if config.phase_source == "time" else None)
+            self.embeddings[s] = emb
+            cyl = emb.to_cylinder(X)  # (N, 3)
+            cyl[:, 0] = np.unwrap(cyl[:, 0])
+            self.nominal[s] = cyl
+
+    @property
+    def n_ticks(self) -> int:
+        """Ticks per cycle ``N``."""
+        return self.ref.loops.shape[1]
+
+    def embedding(self, scale: float) -> GaitEmbedding:
+        """The embedding of a schedule scale."""
+        return self.embeddings[self._key(scale)]
+
+    def _key(self, scale: float) -> float:
+        for s in self.scales:
+            if abs(s - scale) < 1e-9:
+                return s
+        raise unknown_name("scale", f"{scale:g}", [f"{s:g}" for s in self.scales], ConfigError)
+
+    def nominal_action(self, scale: float, tick: int) -> np.ndarray:
+        """χ = (φ, r, h) of the reference at loop tick ``tick`` (φ unwrapped over cycles)."""
+        nom = self.nominal[self._key(scale)]
+        n = len(nom)
+        cycles, i = divmod(tick, n)
+        out = nom[i].copy()
+        out[0] += 2 * np.pi * cycles * np.sign(nom[-1, 0] - nom[0, 0] or 1.0)
+        return out
+
+    def joints(self, scale: float, action: np.ndarray) -> np.ndarray:
+        """Joint targets ``(n,)`` [rad] of an action (φ, r, h): g and C⁺ (the way back)."""
+        x = self.embedding(scale).from_cylinder(np.asarray(action, dtype=float))
+        return self.subspace.inverse_transform(x)
+
+    def phase_step(self, scale: float) -> float:
+        """Mean φ advance per tick of the nominal loop [rad]."""
+        nom = self.nominal[self._key(scale)]
+        return float((nom[-1, 0] - nom[0, 0]) / (len(nom) - 1))
+
+    def report(self) -> dict:
+        """Explained variance, per-joint reconstruction error, φ monotonicity per scale."""
+        out = {
+            "n_components": self.config.n_components,
+            "explained_variance_ratio": self.subspace.explained_variance_ratio_.tolist(),
+            "reconstruction_rms_rad": {},
+            "phase_backwards_fraction": {},
+        }
+        for s in self.scales:
+            loop = self.ref.at_scale(s)[1]
+            err = self.subspace.reconstruction_error(loop)
+            out["reconstruction_rms_rad"][f"{s:g}"] = {
+                "max": float(err.max()),
+                "worst_joint": self.ref.joint_names[int(np.argmax(err))],
+            }
+            d = np.diff(self.nominal[s][:, 0])
+            out["phase_backwards_fraction"][f"{s:g}"] = float(np.mean(d * np.sign(d.sum()) < 0))
+        return out

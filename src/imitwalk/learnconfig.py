@@ -1,0 +1,122 @@
+"""Settings of the learning loop, and the two named variants.
+
+``faithful`` is the paper as written: k = 3 principal components, the data's angle as
+the phase, the 2nd-order RBF model of the gyro, and the per-tick predictive search in
+the local box of eqs. 9–13, learned on the nominal robot. ``extended`` keeps that
+structure and adds, each as its own option: k = 6, the time phase, the step-level
+balance channels with their own step model and search (:mod:`imitwalk.balance`), and
+training on perturbed robots as well as the nominal one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
+
+from imitwalk.balance import StepConfig
+from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.gait import GaitConfig
+
+__all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
+
+
+@dataclass(frozen=True)
+class ScheduleConfig:
+    """The scale schedule (paper §6: start small, where the motion is stable, scale up).
+
+    Attributes:
+        start, step, stop: scales tried, in order.
+        iterations: execute/record/retrain iterations per scale (the paper: three).
+        seconds: simulated time per episode [s], start-up from standing included.
+        retries: more attempts at a scale after a fall before learning stops.
+    """
+
+    start: float = 0.3
+    step: float = 0.1
+    stop: float = 1.0
+    iterations: int = 3
+    seconds: float = 12.0
+    retries: int = 3
+
+    def scales(self) -> tuple[float, ...]:
+        """The schedule's scales."""
+        n = int(round((self.stop - self.start) / self.step)) + 1
+        return tuple(round(self.start + i * self.step, 6) for i in range(max(n, 1)))
+
+
+@dataclass(frozen=True)
+class TickConfig:
+    """The paper's per-tick model-predictive search (§5).
+
+    Attributes:
+        enabled: search each tick (else follow the nominal actions).
+        state: ``"gyro"`` (the paper's ω) or ``"full"`` (ω, roll, pitch).
+        weights: λ of eq. (6) per state dimension.
+        eps_phi: ε_φ as a multiple of the nominal phase step per tick (eq. 9).
+        eps_r, eps_h: ε_r, ε_h as fractions of the loop's mean radius (eqs. 10-11).
+        grid: (n_φ, n_r, n_h) candidates; horizon: ticks predicted ahead.
+        explore: noise on (r, h), a fraction of (ε_r, ε_h), in a scale's first iteration.
+        n_centers, ridge: of the gyro model's RBF network.
+    """
+
+    CHOICES: ClassVar[dict] = {"state": ("gyro", "full")}
+
+    enabled: bool = True
+    state: str = "gyro"
+    weights: tuple[float, ...] = (1.0, 1.0, 1.0)
+    eps_phi: float = 2.0
+    eps_r: float = 0.05
+    eps_h: float = 0.05
+    grid: tuple[int, ...] = (5, 5, 5)
+    horizon: int = 1
+    explore: float = 0.5
+    n_centers: int = 40
+    ridge: float = 1e-3
+
+
+@dataclass(frozen=True)
+class LearnConfig:
+    """Everything a learning run depends on (with the seed, it fixes the result).
+
+    Attributes:
+        variant: the preset these settings started from (a label).
+        gait: representation; schedule: scales; tick: the paper's per-tick search.
+        steps: use the step-level balance channels; step: their settings.
+        train_models: robots per iteration: the nominal one + training perturbations.
+        seed: random seed; workers: parallel processes (``None``: one per core).
+    """
+
+    variant: str = "extended"
+    gait: GaitConfig = field(default_factory=GaitConfig)
+    schedule: ScheduleConfig = field(default_factory=ScheduleConfig)
+    tick: TickConfig = field(default_factory=TickConfig)
+    steps: bool = True
+    step: StepConfig = field(default_factory=StepConfig)
+    train_models: int = 3
+    seed: int = 0
+    workers: int | None = None
+
+
+VARIANTS: dict[str, LearnConfig] = {
+    "faithful": LearnConfig(
+        variant="faithful",
+        gait=GaitConfig(n_components=3, phase_source="angle"),
+        tick=TickConfig(enabled=True),
+        steps=False,
+        train_models=1,
+    ),
+    "extended": LearnConfig(
+        variant="extended",
+        gait=GaitConfig(n_components=6, phase_source="time"),
+        tick=TickConfig(enabled=False),
+        steps=True,
+        train_models=3,
+    ),
+}
+
+
+def preset(name: str, **changes) -> LearnConfig:
+    """The named variant's settings, with ``changes`` applied."""
+    if name not in VARIANTS:
+        raise unknown_name("variant", name, VARIANTS, ConfigError)
+    return replace(VARIANTS[name], **changes)

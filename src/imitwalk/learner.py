@@ -1,0 +1,203 @@
+"""The learning loop (paper §5 steps 3–7, §6): execute, record, retrain, re-optimise, scale up.
+
+Each iteration runs the current controller on the training robots (the nominal one, and
+for the extended variant training perturbations never used for evaluation), records the
+sensory-motor data, refits the models on everything recorded so far and moves along the
+scale schedule: a scale is passed when its last iteration (no exploration) walks without
+a fall on every training robot. After every iteration the run folder is checkpointed
+atomically, so ``resume`` continues an interrupted run and ends where an uninterrupted
+one would (same seed, same result).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict
+
+import numpy as np
+
+from imitwalk.config import to_dict
+from imitwalk.controller import stability_cost
+from imitwalk.errors import RunError
+from imitwalk.gait import GaitModel
+from imitwalk.learnconfig import LearnConfig
+from imitwalk.models import build_policy, fit_models, stack_episodes, unstack_episodes
+from imitwalk.parallel import run_parallel
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+
+__all__ = ["learn"]
+
+
+def _episode(job) -> dict:
+    """One training episode on one robot (runs in a worker process)."""
+    from imitwalk.metrics import walk_metrics
+    from imitwalk.perturb import perturbed
+    from imitwalk.sim import MujocoPlant, run
+
+    robot, gait, scale, cfg, models, seed, explore, rng_seed = job
+    policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
+    ref = gait.ref
+    steps = round(cfg.schedule.seconds / ref.dt)
+    ro = run(MujocoPlant(robot, perturbed(seed, disturbance=seed != 0)), policy, steps)
+    m = walk_metrics(
+        ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
+    )
+    out = {"seed": seed, "metrics": m.to_dict(), "ticks": len(ro.t)}
+    if policy.tick_states:
+        out["tick"] = (np.asarray(policy.tick_states), np.asarray(policy.tick_actions))
+        out["tick_pred"] = float(np.mean(policy.tick_predicted)) if policy.tick_predicted else None
+    if policy.steps is not None:
+        out["step"] = policy.steps.episode()
+        out["step_pred"] = (
+            float(np.mean(policy.steps.predicted)) if policy.steps.predicted else None
+        )
+    g = ro.gyro[len(policy.start) - gait.n_ticks :]
+    out["gyro_cost"] = float(stability_cost(g, np.ones(3)).mean()) if len(g) else None
+    return out
+
+
+def _iteration_log(scale, it, results, reports, t0) -> dict:
+    ms = [r["metrics"] for r in results]
+    pred = [r.get("tick_pred") for r in results if r.get("tick_pred") is not None]
+    spred = [r.get("step_pred") for r in results if r.get("step_pred") is not None]
+    return {
+        "scale": scale,
+        "iteration": it,
+        "robots": len(results),
+        "falls": int(sum(m["fell"] for m in ms)),
+        "fell": [m["fell"] for m in ms],
+        "fall_time_s": [m["fall_time_s"] for m in ms],
+        "cost_measured": float(
+            np.mean([r["gyro_cost"] for r in results if r["gyro_cost"] is not None] or [np.nan])
+        ),
+        "cost_predicted": float(np.mean(pred)) if pred else None,
+        "step_cost_predicted": float(np.mean(spred)) if spred else None,
+        "prediction": reports,
+        "forward_speed_mps": float(np.mean([m["forward_speed_mps"] for m in ms])),
+        "progress_ratio": float(np.mean([m["progress_ratio"] for m in ms])),
+        "yaw_drift_deg": float(np.mean([m["yaw_drift_deg"] for m in ms])),
+        "sim_seconds": float(sum(m["seconds"] for m in ms)),
+        "wall_seconds": time.perf_counter() - t0,
+    }
+
+
+def learn(
+    ref: Reference, robot: Robot, config: LearnConfig, run_dir, resume: bool = False, progress=None
+) -> dict:
+    """Learn to walk ``ref`` on ``robot``; write everything to ``run_dir``.
+
+    Args:
+        ref: the retargeted reference; robot: the robot; config: settings.
+        run_dir: output folder; resume: continue the run there.
+        progress: optional ``callback(line)`` for one line per iteration.
+
+    Returns:
+        the learning summary (also written as ``metrics.json``).
+    """
+    rd = RunDir(run_dir)
+    cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name}
+    if resume:
+        if not rd.exists("checkpoint.json"):
+            raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
+        state = rd.read_json("checkpoint.json")
+        if rd.read_json("config.json")["learn"] != cfg_json["learn"]:
+            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        log = rd.read_log()
+        data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else {}
+    else:
+        if rd.exists("checkpoint.json"):
+            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        rd.path.mkdir(parents=True, exist_ok=True)
+        rd.write_json("config.json", cfg_json)
+        ref.save(rd.file("reference.npz"))
+        state = {
+            "scale_index": 0,
+            "iteration": 0,
+            "failures": 0,
+            "passed": [],
+            "done": False,
+            "total_iterations": 0,
+            "sim_seconds": 0.0,
+            "wall_seconds": 0.0,
+        }
+        log, data = [], {"tick": [], "step": []}
+    scales = config.schedule.scales()
+    gait = GaitModel(ref, scales, config.gait)
+    seeds = (0, *range(1001, 1000 + config.train_models))
+    sch = config.schedule
+    while not state["done"]:
+        t0 = time.perf_counter()
+        si, it = state["scale_index"], state["iteration"]
+        scale = scales[si]
+        models = fit_models(data, config)
+        explore = max(0.0, 1.0 - it / max(sch.iterations - 1, 1)) if sch.iterations > 1 else 0.0
+        jobs = [
+            (
+                robot,
+                gait,
+                scale,
+                config,
+                models,
+                s,
+                explore,
+                [config.seed, state["total_iterations"], j],
+            )
+            for j, s in enumerate(seeds)
+        ]
+        results = run_parallel(_episode, jobs, config.workers)
+        reports = models.held_out(results)
+        for r in results:
+            for kind in ("tick", "step"):
+                if kind in r and len(r[kind][0]) > 2:
+                    data[kind].append(r[kind])
+        entry = _iteration_log(scale, it, results, reports, t0)
+        log.append(entry)
+        fell = entry["falls"] > 0
+        last = it >= sch.iterations - 1
+        if fell:
+            state["failures"] += 1
+            if state["failures"] > sch.retries:
+                state["done"] = True
+        elif last:
+            state["passed"].append(scale)
+            state["failures"] = 0
+        if not state["done"]:
+            if last and not fell:
+                state["scale_index"], state["iteration"] = si + 1, 0
+                state["done"] = si + 1 >= len(scales)
+            else:
+                state["iteration"] = min(it + 1, sch.iterations - 1)
+        state["total_iterations"] += 1
+        state["sim_seconds"] += entry["sim_seconds"]
+        state["wall_seconds"] += entry["wall_seconds"]
+        rd.write_arrays("data.npz", stack_episodes(data))
+        rd.write_log(log)
+        rd.write_json("checkpoint.json", state)
+        if progress:
+            progress(_progress_line(entry))
+    summary = {
+        "variant": config.variant,
+        "scale_reached": max(state["passed"]) if state["passed"] else 0.0,
+        "scales_passed": state["passed"],
+        "iterations": state["total_iterations"],
+        "sim_seconds_used_for_learning": state["sim_seconds"],
+        "wall_seconds_for_learning": state["wall_seconds"],
+        "gait": gait.report(),
+        "config": asdict(config),
+    }
+    rd.write_json("metrics.json", summary)
+    return summary
+
+
+def _progress_line(e: dict) -> str:
+    pred = e["prediction"].get("tick") or e["prediction"].get("step")
+    ratio = f"{pred['overall_ratio']:.2f}" if pred else "  - "
+    cp = f"{e['cost_predicted']:.3f}" if e["cost_predicted"] is not None else "  -  "
+    return (
+        f"scale {e['scale']:.2f} it {e['iteration']} | fell {e['falls']}/{e['robots']} | "
+        f"cost meas {e['cost_measured']:.3f} pred {cp} | pred err/baseline {ratio} | "
+        f"{e['forward_speed_mps']:.3f} m/s, progress {e['progress_ratio']:.2f}, "
+        f"yaw {e['yaw_drift_deg']:+.1f} deg | {e['wall_seconds']:.1f} s"
+    )

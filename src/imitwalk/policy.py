@@ -1,0 +1,125 @@
+"""The walking controller that runs at every control tick (pure NumPy).
+
+It plays the reference's start-up from standing, then walks the gait loop in the
+paper's representation: each tick an action χ_t = (φ, r, h) — the nominal one, or the
+one the model-predictive search of eqs. 5–13 picks — goes to joint targets through g
+and C⁺; on top, the step-level balance channels (:mod:`imitwalk.balance`) add task-space
+offsets, solved exactly by the robot's IK (an injected ``channel_ik(tick, offsets)``,
+e.g. :class:`imitwalk.retarget.online.OnlineIK`), from the first step of the start-up
+on; the joint change it makes is added to the controller's output. Over the last
+start-up cycle the output is cross-faded from the start-up trajectory to the
+controller's. It records what the learner trains on.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from imitwalk.balance import StepController
+from imitwalk.controller import ActionSelector
+from imitwalk.estimator import StateEstimator
+from imitwalk.gait import GaitModel
+
+__all__ = ["WalkPolicy"]
+
+
+class WalkPolicy:
+    """Per-tick controller; call it as ``policy(tick, observation) -> (n,) targets``.
+
+    Args:
+        gait: the gait representation; scale: a schedule scale.
+        tick_selector: the paper's per-tick MPC (``None``: follow the nominal actions).
+        tick_state: ``"gyro"`` (the paper) or ``"full"`` (gyro, roll, pitch) for its model.
+        steps: the step-level channel controller (``None``: no channels).
+        channel_ik: ``(tick, offsets (8,)) -> (n,)`` joint angles of the reference plan with
+            task offsets (zero offsets: the reference itself).
+        explore: uniform noise on (r, h), a fraction of the tick box, during training.
+        rng: noise source.
+    """
+
+    def __init__(
+        self,
+        gait: GaitModel,
+        scale: float,
+        tick_selector: ActionSelector | None = None,
+        tick_state: str = "gyro",
+        steps: StepController | None = None,
+        channel_ik=None,
+        explore: tuple[float, float] = (0.0, 0.0),
+        rng: np.random.Generator | None = None,
+    ):
+        self.gait, self.scale = gait, scale
+        self.selector, self.tick_state = tick_selector, tick_state
+        self.steps, self.channel_ik = steps, channel_ik
+        self.explore, self.rng = np.asarray(explore, dtype=float), rng
+        self.start, self.loop, _ = gait.ref.at_scale(scale)
+        self.n = gait.n_ticks
+        self.estimator = StateEstimator(gait.ref.dt)
+        nom = gait.nominal[gait._key(scale)]
+        self._phi_table = nom[:, 0]
+        self._dphi = gait.phase_step(scale)
+        # records
+        self.tick_states: list[np.ndarray] = []
+        self.tick_actions: list[np.ndarray] = []
+        self.tick_predicted: list[float] = []
+        self._a_prev: np.ndarray | None = None
+        self._step_k = 0
+        self._gyro_sum, self._gyro_n = np.zeros(4), 0
+
+    def _tick_state(self, est) -> np.ndarray:
+        if self.tick_state == "full":
+            return np.array([*est.gyro, est.roll, est.pitch])
+        return est.gyro.copy()
+
+    def __call__(self, k: int, obs) -> np.ndarray:
+        est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
+        m, n = len(self.start), self.n
+        if k < m - n:
+            q = self.start[k].copy()
+        else:
+            i = k - m  # loop tick; negative during the cross-fade cycle
+            q = self._tick(i, est)
+            if i < 0:  # cross-fade from the start-up into the controller over one cycle
+                w = (i + n) / n
+                q = (1.0 - w) * self.start[k] + w * q
+        if self.steps is not None and k >= m % n + n:  # channels act once the feet step
+            offsets = self._channels(k - (m % n + n), est)
+            if np.any(offsets):
+                q = q + self.channel_ik(k, offsets) - self._reference(k)
+            else:
+                self.channel_ik(k, offsets)  # keep the solver's warm start on track
+        return q
+
+    def _reference(self, k: int) -> np.ndarray:
+        m = len(self.start)
+        return self.start[k] if k < m else self.loop[(k - m) % self.n]
+
+    def _tick(self, i: int, est) -> np.ndarray:
+        """The paper's part: action χ_t (nominal or searched) → joint targets via g, C⁺."""
+        nominal = self.gait.nominal_action(self.scale, i)
+        s = self._tick_state(est)
+        if self.selector is not None and self._a_prev is not None and self.tick_states:
+            dec = self.selector.select(s, self.tick_states[-1], self._a_prev)
+            action = dec.action
+            self.tick_predicted.append(dec.cost)
+        else:
+            action = nominal
+        if self.rng is not None and self.explore.any():
+            action = action + np.r_[0.0, self.explore * self.rng.uniform(-1, 1, 2)]
+        self.tick_states.append(s)
+        self.tick_actions.append(action)
+        self._a_prev = action
+        return self.gait.joints(self.scale, action)
+
+    def _channels(self, j: int, est) -> np.ndarray:
+        """Step-level balance channels at stepping tick ``j`` (the clock; 0 = first step)."""
+        self._gyro_sum += np.r_[est.gyro, est.cop_x]
+        self._gyro_n += 1
+        half = self.n / 2.0
+        while j >= self._step_k * half:  # a step boundary (heel strike): decide
+            mean = self._gyro_sum / max(self._gyro_n, 1)  # gyro (3) and cop_x over the step
+            state = np.array([est.roll, est.pitch, est.heading, *mean[:3], est.load_left, mean[3]])
+            self.steps.decide(state, self._step_k)
+            self._step_k += 1
+            self._gyro_sum, self._gyro_n = np.zeros(4), 0
+        return self.steps.offsets(j)

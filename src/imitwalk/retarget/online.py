@@ -1,0 +1,63 @@
+"""Re-solving the walkable reference tick by tick, with task-space offsets.
+
+The balance channels (:mod:`imitwalk.balance`) move the swing foot's landing spot and
+the centre of mass in task space. :class:`OnlineIK` turns such offsets into joint
+angles exactly, by solving the reference's own task-space plan with the offsets added,
+warm-started from the previous tick (so zero offsets give back the reference). The
+controller only sees it as a function ``(tick, offsets) -> joint angles``.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from imitwalk.retarget.ik import CHANNELS, WalkIK
+from imitwalk.retarget.reference import UPPER, Reference
+from imitwalk.robots import Robot
+
+__all__ = ["OnlineIK"]
+
+
+class OnlineIK:
+    """``online(k, offsets) -> (n,)`` joint angles at control tick ``k`` from standing.
+
+    Args:
+        robot: the robot; ref: a walkable reference (with its plan); scale: stride scale.
+    """
+
+    def __init__(self, robot: Robot, ref: Reference, scale: float):
+        self.ik = WalkIK(robot)
+        self.plan = ref.plan_at(scale)
+        self.n_loop = ref.loops.shape[1]
+        self.n_total = len(self.plan["pelvis_z"])
+        self.m = self.n_total - self.n_loop
+        self.stride = ref.at_scale(scale)[2]
+        self._fresh = True
+        self.ik.start(robot.stand_qpos)
+
+    def _tick_plan(self, k: int) -> SimpleNamespace:
+        if k < self.n_total:
+            i, shift = k, 0.0
+        else:
+            c, r = divmod(k - self.m, self.n_loop)
+            i, shift = self.m + r, c * self.stride
+        p = self.plan
+        dx = np.array([shift, 0.0, 0.0])
+        return SimpleNamespace(
+            l_sole=(p["l_sole"][i] + dx)[None],
+            r_sole=(p["r_sole"][i] + dx)[None],
+            com=(p["com"][i] + dx[:2])[None],
+            pelvis_z=p["pelvis_z"][i : i + 1],
+            upper={u: p["upper"][i : i + 1, j] for j, u in enumerate(UPPER)},
+        )
+
+    def __call__(self, k: int, offsets: np.ndarray) -> np.ndarray:
+        """Joint angles [rad] at tick ``k`` with ``offsets`` ``(8,)`` in ``CHANNELS`` order."""
+        it = 30 if self._fresh else 10
+        self._fresh = False
+        return self.ik.solve_tick(self._tick_plan(k), 0, offsets, max_iter=it)
+
+
+_ = CHANNELS

@@ -1,0 +1,95 @@
+"""The robustness grid: one perturbation per cell, learned and open loop side by side.
+
+Cells (each on top of the evaluation robots, seed 0 nominal and the rest perturbed):
+floor friction × 0.5, 0.75, 1.25, 1.5; every mass × 0.8, 0.9, 1.1, 1.2; gyro noise;
+a servo delay of one and of two control periods; a ±3° slope along the walk; and a
+lateral push on the torso in the middle of the walk, in two sizes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from imitwalk.evaluate import per_seed
+from imitwalk.robots import Robot
+from imitwalk.sim import SimOptions
+
+__all__ = ["CELLS", "robustness_grid"]
+
+#: Push size: a force [N] on the torso for 0.1 s (impulses of 1 and 2 N·s).
+PUSHES = {"push_small": 10.0, "push_large": 20.0}
+#: Gyro noise standard deviation in its cell [rad/s].
+GYRO_NOISE = 0.03
+
+
+def _cells(seconds: float) -> dict[str, SimOptions]:
+    base = SimOptions()
+    cells = {"nominal": base}
+    for f in (0.5, 0.75, 1.25, 1.5):
+        cells[f"friction_x{f:g}"] = replace(base, friction_scale=f)
+    for m in (0.8, 0.9, 1.1, 1.2):
+        cells[f"mass_x{m:g}"] = replace(base, mass_scale=m)
+    cells["gyro_noise"] = replace(base, gyro_noise=GYRO_NOISE)
+    cells["delay_1"] = replace(base, servo_delay=1)
+    cells["delay_2"] = replace(base, servo_delay=2)
+    cells["slope_up_3deg"] = replace(base, slope_deg=3.0)
+    cells["slope_down_3deg"] = replace(base, slope_deg=-3.0)
+    for name, force in PUSHES.items():
+        cells[name] = replace(
+            base, push_time=seconds / 2, push_duration=0.1, push_force=(0.0, force, 0.0)
+        )
+    return cells
+
+
+#: The cell names, in order.
+CELLS = tuple(_cells(20.0))
+
+
+def robustness_grid(
+    run_dir,
+    robot: Robot,
+    seconds: float = 20.0,
+    seeds: int = 5,
+    workers=None,
+    progress=None,
+    cells: tuple[str, ...] | None = None,
+) -> dict:
+    """Survival and distance per cell, learned vs open loop.
+
+    Returns:
+        ``{"cells": {name: {"learned": {...}, "open_loop": {...}}}, "totals": {...}}`` where
+        each side has ``survived`` (of ``seeds``) and ``distance_m`` (mean), and totals
+        count the cells in which every seed survived.
+    """
+    grid = _cells(seconds)
+    names = cells or tuple(grid)
+    out: dict = {"seconds": seconds, "seeds": seeds, "cells": {}}
+    for name in names:
+        res = per_seed(run_dir, robot, seconds, list(range(seeds)), grid[name], workers)
+        row = {}
+        for mode, runs in res.items():
+            row[mode] = {
+                "survived": int(sum(not r["fell"] for r in runs)),
+                "of": len(runs),
+                "distance_m": float(np.mean([r["forward_distance_m"] for r in runs])),
+                "yaw_drift_deg": float(np.mean([abs(r["yaw_drift_deg"]) for r in runs])),
+            }
+        out["cells"][name] = row
+        if progress:
+            progress(
+                f"  {name:>16}: learned {row['learned']['survived']}/{seeds}, "
+                f"open loop {row['open_loop']['survived']}/{seeds}"
+            )
+    out["totals"] = {
+        mode: {
+            "cells_all_survived": int(
+                sum(c[mode]["survived"] == c[mode]["of"] for c in out["cells"].values())
+            ),
+            "survived": int(sum(c[mode]["survived"] for c in out["cells"].values())),
+            "runs": int(sum(c[mode]["of"] for c in out["cells"].values())),
+        }
+        for mode in ("learned", "open_loop")
+    }
+    return out

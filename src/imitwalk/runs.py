@@ -1,0 +1,92 @@
+"""A learning run's folder: config, log, data, checkpoint, metrics — written atomically.
+
+RUN_DIR/
+  config.json      the learning settings and where the reference came from
+  reference.npz    the retargeted reference the run learned on
+  data.npz         every recorded episode (what the models are fitted on)
+  log.jsonl        one line per learning iteration
+  checkpoint.json  where the schedule is (written after every iteration)
+  metrics.json     the learning summary (scale reached, cost of learning)
+  evaluation.json  written by ``imitwalk evaluate``
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk.errors import RunError
+from imitwalk.retarget.reference import atomic_write
+
+__all__ = ["RunDir"]
+
+
+def _json_default(v):
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, Path):
+        return str(v)
+    raise TypeError(f"not JSON serialisable: {type(v).__name__}")
+
+
+class RunDir:
+    """Read and write the files of one run folder."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+
+    def file(self, name: str) -> Path:
+        """Path of a file in the run folder."""
+        return self.path / name
+
+    def exists(self, name: str) -> bool:
+        """True if the file is there."""
+        return self.file(name).is_file()
+
+    def write_json(self, name: str, obj) -> Path:
+        """Write ``obj`` as JSON atomically."""
+        text = json.dumps(obj, indent=2, default=_json_default)
+        return atomic_write(self.file(name), lambda tmp: tmp.write_text(text + "\n"))
+
+    def read_json(self, name: str):
+        """Read a JSON file; :class:`RunError` if missing or broken."""
+        p = self.file(name)
+        if not p.is_file():
+            raise RunError(f"{p} not found: is {self.path} a finished imitwalk run?")
+        try:
+            return json.loads(p.read_text())
+        except json.JSONDecodeError as exc:
+            raise RunError(f"{p} is not valid JSON: {exc.msg}") from None
+
+    def write_log(self, entries: list[dict]) -> Path:
+        """Rewrite the per-iteration log (one JSON object per line) atomically."""
+        lines = "".join(json.dumps(e, default=_json_default) + "\n" for e in entries)
+        return atomic_write(self.file("log.jsonl"), lambda tmp: tmp.write_text(lines))
+
+    def read_log(self) -> list[dict]:
+        """The per-iteration log (empty if none)."""
+        p = self.file("log.jsonl")
+        if not p.is_file():
+            return []
+        return [json.loads(line) for line in p.read_text().splitlines() if line.strip()]
+
+    def write_arrays(self, name: str, arrays: dict[str, np.ndarray]) -> Path:
+        """Write a dict of arrays as compressed ``.npz`` atomically."""
+
+        def write(tmp: Path) -> None:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
+
+        return atomic_write(self.file(name), write)
+
+    def read_arrays(self, name: str) -> dict[str, np.ndarray]:
+        """Read an ``.npz`` written by :meth:`write_arrays`."""
+        p = self.file(name)
+        if not p.is_file():
+            raise RunError(f"{p} not found")
+        with np.load(p, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}

@@ -1,0 +1,160 @@
+"""The learning loop: determinism, checkpoint/resume, and the run folder."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from imitwalk.cli import main
+from imitwalk.config import apply_overrides
+from imitwalk.learnconfig import preset
+from imitwalk.learner import learn
+from imitwalk.mocap import default_clip, load_motion
+from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.robots import load_robot
+from imitwalk.runs import RunDir
+
+TINY = [
+    "schedule.start=0.3",
+    "schedule.stop=0.4",
+    "schedule.iterations=2",
+    "schedule.seconds=6",
+    "workers=1",
+]
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return load_robot("hoap2")
+
+
+@pytest.fixture(scope="module")
+def reference(robot, tmp_path_factory):
+    cfg = RetargetConfig(search=False, scales=(0.3, 0.4), params=GaitParams(sway=0.9, ds=0.1))
+    ref = retarget(load_motion(default_clip()), robot, cfg).reference
+    path = tmp_path_factory.mktemp("ref") / "ref.npz"
+    ref.save(path)
+    return ref, path
+
+
+def _strip(m: dict) -> dict:
+    return {k: v for k, v in m.items() if k != "wall_seconds_for_learning"}
+
+
+@pytest.mark.parametrize("variant", ["faithful", "extended"])
+def test_same_seed_same_result(tmp_path, robot, reference, variant):
+    ref, _ = reference
+    cfg = apply_overrides(preset(variant), [*TINY, "train_models=2"])
+    a = learn(ref, robot, cfg, tmp_path / "a")
+    b = learn(ref, robot, cfg, tmp_path / "b")
+    assert _strip(a) == _strip(b)
+    la, lb = RunDir(tmp_path / "a").read_log(), RunDir(tmp_path / "b").read_log()
+    strip = lambda log: [{k: v for k, v in e.items() if k != "wall_seconds"} for e in log]  # noqa: E731
+    assert strip(la) == strip(lb)
+
+
+def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, reference):
+    ref, _ = reference
+    cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2"])
+    whole = learn(ref, robot, cfg, tmp_path / "whole")
+    calls = []
+
+    def interrupt(line):
+        calls.append(line)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
+    rd = RunDir(tmp_path / "cut")
+    assert rd.read_json("checkpoint.json")["total_iterations"] == 2
+    assert not rd.exists("metrics.json")
+    resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
+    assert _strip(resumed) == _strip(whole)
+    log_w = [e["falls"] for e in RunDir(tmp_path / "whole").read_log()]
+    assert [e["falls"] for e in rd.read_log()] == log_w
+
+
+def test_run_folder_contents(tmp_path, robot, reference):
+    ref, _ = reference
+    cfg = apply_overrides(preset("faithful"), TINY)
+    summary = learn(ref, robot, cfg, tmp_path / "run")
+    rd = RunDir(tmp_path / "run")
+    for name in (
+        "config.json",
+        "reference.npz",
+        "data.npz",
+        "log.jsonl",
+        "checkpoint.json",
+        "metrics.json",
+    ):
+        assert rd.exists(name), name
+    log = rd.read_log()
+    assert len(log) == summary["iterations"] >= 2
+    for e in log:
+        assert {
+            "scale",
+            "iteration",
+            "falls",
+            "cost_measured",
+            "cost_predicted",
+            "prediction",
+        } <= set(e)
+    assert summary["sim_seconds_used_for_learning"] == pytest.approx(
+        sum(e["sim_seconds"] for e in log)
+    )
+    # the faithful variant's model is judged against the no-action baseline
+    reports = [e["prediction"]["tick"] for e in log if "tick" in e["prediction"]]
+    assert reports and {"rmse", "baseline_rmse", "ratio"} <= set(reports[0])
+
+
+def test_refuses_to_overwrite_and_to_resume_nothing(tmp_path, robot, reference):
+    from imitwalk.errors import RunError
+
+    ref, _ = reference
+    cfg = apply_overrides(preset("faithful"), [*TINY, "schedule.stop=0.3", "schedule.iterations=1"])
+    with pytest.raises(RunError, match="nothing to resume"):
+        learn(ref, robot, cfg, tmp_path / "x", resume=True)
+    learn(ref, robot, cfg, tmp_path / "x")
+    with pytest.raises(RunError, match="already holds a run"):
+        learn(ref, robot, cfg, tmp_path / "x")
+
+
+def test_cli_learn_and_evaluate(tmp_path, capsys, reference):
+    _, path = reference
+    out = tmp_path / "run"
+    argv = ["learn", "--reference", str(path), "--out", str(out), "--json"]
+    argv += [a for s in TINY for a in ("--set", s)]
+    assert main(argv) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["iterations"] >= 2 and res["run_dir"] == str(out)
+    argv = ["evaluate", str(out), "--seconds", "6", "--seeds", "2", "--json", "--workers", "1"]
+    assert main(argv) == 0
+    ev = json.loads(capsys.readouterr().out)
+    keys = {
+        "falls",
+        "forward_distance_m",
+        "forward_speed_mps",
+        "progress_ratio",
+        "lateral_drift_m",
+        "yaw_drift_deg",
+        "gyro_rms",
+        "joint_rms_error_rad",
+        "cycle_period_s",
+        "scale_reached",
+        "sim_seconds_used_for_learning",
+        "wall_seconds_for_learning",
+        "iterations",
+    }
+    assert keys <= set(ev["learned"]) and keys <= set(ev["open_loop"])
+    for k in ("progress_ratio", "yaw_drift_deg"):
+        assert set(ev["learned"][k]) == {"mean", "min", "max"}
+    assert RunDir(out).exists("evaluation.json")
+    assert np.isfinite(ev["open_loop"]["forward_distance_m"]["mean"])
+
+
+def test_evaluate_a_folder_that_is_not_a_run(tmp_path, capsys):
+    assert main(["evaluate", str(tmp_path)]) == 2
+    assert "not found" in capsys.readouterr().err
