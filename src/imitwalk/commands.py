@@ -286,3 +286,17 @@ def demo(args: argparse.Namespace) -> int:
     emit(summary, args.json)
     progress(f"demo: report written to {report}")
     return 0
+
+
+def report(args: argparse.Namespace) -> int:
+    from imitwalk.report import write_report
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    rd.read_json("metrics.json")  # a clear error if this is not a finished run
+    robot = None
+    if args.robot:
+        robot = robot_from(args)
+    path = write_report(rd.path, robot, seconds=args.seconds, progress=progress)
+    emit({"report": str(path)}, args.json)
+    return 0

@@ -108,9 +108,10 @@ VARIANTS: dict[str, LearnConfig] = {
     "extended": LearnConfig(
         variant="extended",
         gait=GaitConfig(n_components=6, phase_source="time"),
+        schedule=ScheduleConfig(seconds=16.0),
         tick=TickConfig(enabled=False),
         steps=True,
-        train_models=3,
+        train_models=6,
     ),
 }
 

@@ -99,9 +99,30 @@ def save_png(image: np.ndarray, path: str | Path) -> Path:
 
 
 def write_mp4(frames: Sequence[np.ndarray], path: str | Path, fps: float = 30.0) -> Path:
-    """Encode ``frames`` (each ``(H, W, 3)`` uint8) as H.264 MP4 with imageio-ffmpeg."""
+    """Encode ``frames`` (each ``(H, W, 3)`` uint8, all the same size) as H.264 MP4
+    (yuv420p, browser-playable) with imageio-ffmpeg; odd sizes are padded to even."""
+    import imageio_ffmpeg
+
+    if len(frames) == 0:
+        raise ValueError("no frames to encode")
     path = Path(path)
     tmp = path.with_name(path.stem + ".tmp" + path.suffix)
-    iio.imwrite(tmp, np.stack(frames), fps=fps, codec="libx264", plugin="pyav")
+    h, w = frames[0].shape[:2]
+    pad = ((0, h % 2), (0, w % 2), (0, 0))
+    writer = imageio_ffmpeg.write_frames(
+        str(tmp),
+        (w + w % 2, h + h % 2),
+        fps=fps,
+        codec="libx264",
+        pix_fmt_out="yuv420p",
+        macro_block_size=2,
+        output_params=["-movflags", "+faststart"],
+    )
+    writer.send(None)
+    try:
+        for f in frames:
+            writer.send(np.ascontiguousarray(np.pad(np.asarray(f, dtype=np.uint8)[..., :3], pad)))
+    finally:
+        writer.close()
     tmp.replace(path)
     return path

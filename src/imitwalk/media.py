@@ -1,0 +1,171 @@
+"""What the report shows of the robot: replays from standing, rendered video and strips.
+
+:func:`replay` runs a learned run's open-loop reference ("before") and its learned
+controller ("after") on the nominal robot; :func:`video` renders both side by side,
+labelled; :func:`robot_strip` and :func:`human_strip` give Fig. 8's film-strip rows.
+Rendering goes through :mod:`imitwalk.render` (offscreen, fast settings).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk import plots
+from imitwalk.robots import Robot
+from imitwalk.sim import MujocoPlant, Rollout, SimOptions, playback, run
+
+__all__ = [
+    "Replays",
+    "ReportSettings",
+    "gyro_until_fall",
+    "human_strip",
+    "outcome",
+    "pose_qpos",
+    "replay",
+    "robot_strip",
+    "video",
+]
+
+
+@dataclass(frozen=True)
+class ReportSettings:
+    """Rendering settings (kept small so a report takes seconds).
+
+    Attributes:
+        fps: video frame rate [Hz]; width, height: size of each video half [px].
+        strip_frames: images per film-strip row and example poses of Fig. 3.
+        strip_width, strip_height: film-strip and pose image size [px].
+        video_camera, strip_camera: (distance [m], azimuth [deg], elevation [deg]); the
+            strips and poses are seen from the side, like the human skeleton.
+    """
+
+    fps: float = 25.0
+    width: int = 384
+    height: int = 288
+    strip_frames: int = 6
+    strip_width: int = 240
+    strip_height: int = 300
+    video_camera: tuple[float, float, float] = (1.2, 120.0, -20.0)
+    strip_camera: tuple[float, float, float] = (0.9, 90.0, -12.0)
+
+
+def gyro_until_fall(ro: Rollout, margin: float = 0.3) -> np.ndarray:
+    """Gyro ``(N, 3)`` up to a little after the fall (afterwards it is the robot lying)."""
+    if ro.fall_time is None:
+        return ro.gyro
+    return ro.gyro[: int(np.searchsorted(ro.t, ro.fall_time + margin))]
+
+
+def outcome(ro: Rollout) -> str:
+    d = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
+    fell = f"fell at {ro.fall_time:.2f} s" if ro.fell else "did not fall"
+    return f"{fell}; torso moved {d:+.2f} m along x in {ro.seconds:.1f} s"
+
+
+def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
+    from PIL import Image, ImageDraw, ImageFont
+
+    img = Image.fromarray(frame)
+    draw = ImageDraw.Draw(img)
+    style = {"font": ImageFont.load_default(size=15), "stroke_width": 2, "stroke_fill": "white"}
+    for i, (text, color) in enumerate(lines):
+        draw.text((8, 6 + 18 * i), text, fill=color, **style)
+    return np.asarray(img)
+
+
+def video(robot: Robot, runs: list[tuple[str, Rollout]], seconds: float, s: ReportSettings):
+    """Side-by-side frames ``(H, 2W + 4, 3)`` of the two runs, labelled."""
+    from imitwalk.render import render_frames
+
+    halves = []
+    n = max(1, round(seconds * s.fps))
+    view = dict(zip(("distance", "azimuth", "elevation"), s.video_camera, strict=True))
+    for name, ro in runs:
+        frames = render_frames(
+            robot, ro.qpos, ro.control_dt, s.fps, width=s.width, height=s.height, **view
+        )
+        frames = (frames + frames[-1:] * n)[:n]  # hold the last frame of a short run
+        out = []
+        for k, f in enumerate(frames):
+            t = k / s.fps
+            lines = [(name, (0, 0, 0)), (f"t = {t:4.1f} s", (40, 40, 40))]
+            if ro.fell and t >= ro.fall_time:
+                lines.append((f"fell at {ro.fall_time:.1f} s", (200, 0, 0)))
+            out.append(_label(f, lines))
+        halves.append(out)
+    gap = np.full((s.height, 4, 3), 255, np.uint8)
+    return [np.hstack([a, gap, b]) for a, b in zip(*halves, strict=True)]
+
+
+def robot_strip(renderer, ro: Rollout, period: float, count: int) -> tuple[list, list[str]]:
+    """Images of the last gait cycle of a run (the fallen robot, if it fell)."""
+    t_end = ro.seconds
+    times = np.linspace(max(0.0, t_end - period), t_end, count, endpoint=False)
+    idx = np.clip(np.round(times / ro.control_dt).astype(int), 0, len(ro.qpos) - 1)
+    return [renderer.frame(ro.qpos[i]) for i in idx], [f"t = {ro.t[i]:.2f} s" for i in idx]
+
+
+def human_strip(ref, count: int):
+    """Fig. 8's first row (or the reason it is missing)."""
+    from imitwalk.errors import MocapError
+    from imitwalk.mocap import load_motion
+
+    try:
+        motion = load_motion(ref.source)
+    except (MocapError, OSError) as exc:  # a missing or unreadable source: say so
+        return None, f"the human motion could not be loaded from {ref.source!r}: {exc}"
+    if len(ref.cycles):
+        a, b = (int(v) for v in ref.cycles[0])
+    else:
+        a, b = 0, motion.n_frames
+    frames = np.linspace(a, b, count, endpoint=False).astype(int)
+    if motion.loop:  # cycles of a looping clip count frames of the clip repeated
+        frames %= int(motion.meta.get("period_frames", motion.n_frames))
+    frames = np.clip(frames, 0, motion.n_frames - 1)
+    label = f"human demonstration ({Path(ref.source).name}, one gait cycle)"
+    return plots.skeleton_strip(motion, frames, label), None
+
+
+def pose_qpos(robot: Robot, q: np.ndarray) -> np.ndarray:
+    plant = MujocoPlant(robot, SimOptions())
+    plant.reset(q)  # puts the posture on the floor, no physics step
+    return plant.data.qpos.copy()
+
+
+@dataclass
+class Replays:
+    """The report's two runs from standing at one scale (nominal robot).
+
+    ``before``: the reference played open loop; ``after``: the learned controller;
+    ``actions``: ``(T, 3)`` the (φ, r, h) it executed in the gait loop, up to its fall.
+    """
+
+    scale: float
+    before: Rollout
+    after: Rollout
+    actions: np.ndarray
+
+    @property
+    def runs(self) -> list[tuple[str, Rollout]]:
+        """(label, rollout) of each run, before first."""
+        return [("before: open loop", self.before), ("after: learned", self.after)]
+
+
+def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Replays:
+    """Run the open-loop reference and the learned controller of a loaded run
+    (:func:`~imitwalk.evaluate.load_gait`) for ``seconds`` [s] at ``scale`` (default:
+    the scale reached), without stopping at a fall; they start as in
+    :mod:`imitwalk.evaluate`."""
+    scale = lg.scale if scale is None else scale
+    q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
+    before = playback(MujocoPlant(robot, SimOptions()), q_ref, q0=q_ref[0], stop_on_fall=False)
+    policy = lg.policy(robot, scale)
+    after = run(MujocoPlant(robot, SimOptions()), policy, len(q_ref), stop_on_fall=False)
+    actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
+    if after.fell:  # the loop's actions start one cycle before the start-up ends
+        first = len(lg.ref.at_scale(scale)[0]) - lg.gait.n_ticks
+        actions = actions[: max(0, round(after.fall_time / after.control_dt) - first)]
+    return Replays(scale, before, after, actions)

@@ -1,0 +1,300 @@
+"""A run's report: one self-contained HTML page, viewable offline.
+
+:func:`write_report` replays the run at the scale it reached from standing, twice (the
+open-loop reference, "before", and the learned controller, "after", nominal robot),
+renders both offscreen and writes ``RUN_DIR/report.html`` with the paper's figures
+(3, 4, 6, 7 and 8), the learning curves, the gyro traces, the evaluation metrics, the
+robustness grid and the configuration. Figures are inline base64 PNGs and the
+before/after video an inline base64 H.264 MP4: no external URL, no JavaScript. The video
+and the Fig. 8 film strip are also saved as ``before_after.mp4`` and ``filmstrip.png``.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import time
+from pathlib import Path
+
+from imitwalk import curves, media, plots
+from imitwalk.evaluate import load_gait
+from imitwalk.retarget.reference import atomic_write
+from imitwalk.robots import Robot, load_robot
+from imitwalk.runs import RunDir
+
+__all__ = ["write_report"]
+
+
+def _b64(data: bytes) -> str:
+    return base64.b64encode(data).decode("ascii")
+
+
+def _img(fig, alt: str) -> str:
+    png = plots.png_bytes(fig)
+    return f'<img src="data:image/png;base64,{_b64(png)}" alt="{html.escape(alt)}">'
+
+
+def _fmt(v) -> str:
+    if isinstance(v, dict) and "mean" in v:
+        return f"{v['mean']:.3g} <small>({v['min']:.3g} … {v['max']:.3g})</small>"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if v is None:
+        return "–"
+    return html.escape(str(v))
+
+
+def _metrics_table(ev: dict) -> str:
+    learned, open_loop = ev.get("learned", {}), ev.get("open_loop", {})
+    rows = []
+    for k in learned:
+        if k == "per_seed":
+            continue
+        v, w = learned[k], open_loop.get(k)
+        if k == "falls":
+            v, w = f"{v} of {learned.get('seeds')}", f"{w} of {open_loop.get('seeds')}"
+        rows.append(f"<tr><th>{html.escape(k)}</th><td>{_fmt(v)}</td><td>{_fmt(w)}</td></tr>")
+    st = ev.get("settings", {})
+    note = ", ".join(f"{html.escape(str(k))} = {html.escape(str(v))}" for k, v in st.items())
+    return (
+        f"<p>From <code>evaluation.json</code> ({note}); per-seed values are "
+        "mean (min … max).</p><table><tr><th></th><th>learned</th><th>open loop</th></tr>"
+        + "".join(rows)
+        + "</table>"
+    )
+
+
+def _robustness_table(rob: dict) -> str:
+    rows = []
+    for name, c in rob.get("cells", {}).items():
+        cells = "".join(
+            f"<td>{c[m]['survived']}/{c[m]['of']}, {c[m]['distance_m']:.2f} m</td>"
+            for m in ("learned", "open_loop")
+        )
+        rows.append(f"<tr><th>{html.escape(name)}</th>{cells}</tr>")
+    return (
+        "<table><tr><th>cell</th><th>learned</th><th>open loop</th></tr>"
+        + "".join(rows)
+        + "</table>"
+    )
+
+
+STYLE = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}
+img,video{max-width:100%;height:auto;display:block;margin:.5em 0}
+table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;
+text-align:left}.missing{color:#a00}figcaption{font-size:.9em;color:#444;margin-bottom:1em}
+pre{background:#f6f6f6;padding:.5em;overflow:auto}"""
+
+
+def _section(title: str, body: str) -> str:
+    return f"<section><h2>{html.escape(title)}</h2>\n{body}\n</section>\n"
+
+
+def _figure(img: str, caption: str) -> str:
+    return f"<figure>{img}<figcaption>{caption}</figcaption></figure>"
+
+
+def write_report(
+    run_dir,
+    robot: Robot | None = None,
+    seconds: float = 10.0,
+    progress=None,
+    settings: media.ReportSettings | None = None,
+) -> Path:
+    """Write ``RUN_DIR/report.html`` (and ``before_after.mp4``, ``filmstrip.png``).
+
+    Args:
+        run_dir: a finished learning run (see :mod:`imitwalk.runs`).
+        robot: the robot (default: the one named in ``config.json``).
+        seconds: length of the two replays from standing [s].
+        progress: optional ``callback(line)``.
+        settings: rendering settings.
+    Returns:
+        the path of ``report.html``.
+    Raises:
+        RunError: ``run_dir`` is not a finished run.
+    """
+    say = progress or (lambda _line: None)
+    s = settings or media.ReportSettings()
+    t0 = time.perf_counter()
+    rd = RunDir(run_dir)
+    lg = load_gait(run_dir)
+    config = rd.read_json("config.json")
+    robot = robot or load_robot(config.get("robot", lg.ref.robot))
+    say(f"report: replaying {seconds:g} s at scale {lg.scale:g} (open loop, learned)")
+    rp = media.replay(lg, robot, seconds)
+
+    say("report: rendering the video")
+    from imitwalk.render import Renderer, write_mp4
+
+    frames = media.video(robot, rp.runs, seconds, s)
+    mp4 = write_mp4(frames, rd.file("before_after.mp4"), s.fps)
+    h, w = frames[0].shape[:2]
+    video = (
+        f'<video controls muted loop playsinline width="{w}" height="{h}" '
+        f'src="data:video/mp4;base64,{_b64(mp4.read_bytes())}"></video>'
+    )
+
+    say("report: rendering film strips and poses")
+    renderer = Renderer(robot, s.strip_width, s.strip_height, *s.strip_camera)
+    try:
+        strips = [
+            media.robot_strip(renderer, ro, lg.ref.period, s.strip_frames) for _, ro in rp.runs
+        ]
+        ticks = plots.example_ticks(lg.gait.n_ticks, s.strip_frames)
+        loop = lg.ref.at_scale(rp.scale)[1]  # (N, n)
+        poses = [renderer.frame(media.pose_qpos(robot, loop[k])) for k in ticks]
+    finally:
+        renderer.close()
+
+    say("report: drawing figures")
+    fig8 = _fig8(lg.ref, rp, strips, s.strip_frames, rd.file("filmstrip.png"))
+    body = _sections(rd, lg, rp, config, video, fig8, poses, ticks)
+    title = html.escape(f"imitwalk run {rd.path.name}")
+    m = lg.metrics
+    page = (
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}'
+        f'</title><link rel="icon" href="data:,"><style>{STYLE}</style></head><body>\n'
+        f"<h1>{title}</h1>\n<p>{html.escape(str(m.get('variant', '')))} variant; scale "
+        f"reached {lg.scale:g}; {m.get('iterations')} learning iterations; report made in "
+        f"{time.perf_counter() - t0:.0f} s.</p>\n{body}</body></html>\n"
+    )
+    out = atomic_write(rd.file("report.html"), lambda tmp: tmp.write_text(page, "utf-8"))
+    say(f"report: wrote {out} in {time.perf_counter() - t0:.1f} s")
+    return out
+
+
+def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
+    """Fig. 8's rows as HTML; also saved, stacked, as ``png``."""
+    human, missing = media.human_strip(ref, count)
+    rows = [] if human is None else [(human, "film strip: human")]
+    for (images, titles), (name, ro) in zip(strips, rp.runs, strict=True):
+        label = f"robot {name} (last gait cycle; {media.outcome(ro)})"
+        rows.append(
+            (plots.film_strip(images, titles, label), f"film strip: robot {name.split(':')[0]}")
+        )
+    _save_strip([f for f, _ in rows], png)
+    out = "".join(_img(f, alt) for f, alt in rows)
+    if missing:
+        out = f'<p class="missing">{html.escape(missing)}</p>' + out
+    return _figure(
+        out,
+        "Rows: the human demonstration (mocap keypoints, side view), the "
+        "robot playing the reference open loop (before), the robot with the learned "
+        "controller (after).",
+    )
+
+
+def _sections(
+    rd: RunDir, lg, rp: media.Replays, config: dict, video: str, fig8: str, poses, ticks
+) -> str:
+    gait, scale, log, m = lg.gait, rp.scale, rd.read_log(), lg.metrics
+    passed = [float(p) for p in m.get("scales_passed", [])]
+    at_final = bool(passed) and abs(max(passed) - scale) < 1e-9
+    evr = gait.subspace.explained_variance_ratio_
+    if rd.exists("evaluation.json"):
+        evaluation = _metrics_table(rd.read_json("evaluation.json"))
+    else:
+        evaluation = (
+            '<p class="missing">No <code>evaluation.json</code>: run '
+            "<code>imitwalk evaluate RUN</code>.</p>"
+        )
+    gyro = curves.gyro_traces(
+        media.gyro_until_fall(rp.before),
+        media.gyro_until_fall(rp.after),
+        rp.before.control_dt,
+        fall_times=(rp.before.fall_time, rp.after.fall_time),
+    )
+    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None)
+    sections = [
+        (
+            "Before and after",
+            video + f"<p>Nominal robot, from standing, at the scale reached "
+            f"({scale:g}). Open loop: {media.outcome(rp.before)}. "
+            f"Learned: {media.outcome(rp.after)}.</p>",
+        ),
+        ("Fig. 8: learning to walk through imitation", fig8),
+        ("Evaluation", evaluation),
+        (
+            "Learning",
+            _figure(
+                _img(curves.learning_curves(log), "learning curves"),
+                f"{len(log)} iterations; {m.get('sim_seconds_used_for_learning')} s simulated; "
+                f"scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}.",
+            ),
+        ),
+        (
+            "Torso gyro",
+            _figure(
+                _img(gyro, "gyro traces"),
+                "The replays above, up to just "
+                "after a fall (dashed: the fall); eq. 6 weighs their squares.",
+            ),
+        ),
+        (
+            "Fig. 3: posture subspace",
+            _figure(
+                _img(plots.fig3_subspace(gait, scale, poses, ticks), "Fig. 3"),
+                "Explained variance: "
+                + ", ".join(f"PC{i + 1} {100 * v:.1f} %" for i, v in enumerate(evr))
+                + ".",
+            ),
+        ),
+        (
+            "Fig. 4: embedded action space",
+            _figure(
+                _img(plots.fig4_embedding(gait, scale), "Fig. 4"),
+                "The frame of eq. 1 and g(φ) of eq. 2.",
+            ),
+        ),
+        (
+            "Fig. 6: optimised pattern",
+            _figure(
+                _img(plots.fig6_optimized(gait, scale, rp.actions), "Fig. 6"),
+                "The actions (φ, r, h) the learned "
+                "controller executed in the replay above (up to its fall, if it fell).",
+            ),
+        ),
+        (
+            "Fig. 7: motion pattern scaling",
+            _figure(
+                _img(fig7, "Fig. 7"),
+                "The schedule's "
+                "scales; red circles: the last cycle the learned controller executed above.",
+            ),
+        ),
+        ("Robustness", _robustness(rd)),
+        (
+            "Configuration",
+            "<details><summary>config.json</summary><pre>"
+            + html.escape(json.dumps(config, indent=2))
+            + "</pre></details>",
+        ),
+    ]
+    return "".join(_section(t, b) for t, b in sections)
+
+
+def _robustness(rd: RunDir) -> str:
+    if not rd.exists("robustness.json"):
+        return (
+            '<p class="missing">No <code>robustness.json</code>: run '
+            "<code>imitwalk evaluate RUN --perturb</code>.</p>"
+        )
+    rob = rd.read_json("robustness.json")
+    return _img(curves.robustness_heatmap(rob), "robustness") + _robustness_table(rob)
+
+
+def _save_strip(figs, path: Path) -> Path:
+    """The film-strip figures stacked into one PNG (white-padded to the widest)."""
+    from PIL import Image
+
+    imgs = [Image.open(io.BytesIO(plots.png_bytes(f))).convert("RGB") for f in figs]
+    w = max(i.width for i in imgs)
+    out = Image.new("RGB", (w, sum(i.height for i in imgs)), "white")
+    y = 0
+    for i in imgs:
+        out.paste(i, (0, y))
+        y += i.height
+    return atomic_write(path, lambda tmp: out.save(tmp, format="PNG"))

@@ -1,0 +1,207 @@
+"""The run report: one self-contained HTML page that a real headless Chromium shows
+without errors, with every figure and the before/after video."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+
+import pytest
+
+from imitwalk.cli import main
+from imitwalk.config import apply_overrides
+from imitwalk.evaluate import load_gait
+from imitwalk.learnconfig import preset
+from imitwalk.learner import learn
+from imitwalk.mocap import default_clip, load_motion
+from imitwalk.report import write_report
+from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import load_robot
+from imitwalk.robustness import robustness_grid
+from imitwalk.runs import RunDir
+
+TINY = [
+    "schedule.start=0.3",
+    "schedule.stop=0.4",
+    "schedule.iterations=2",
+    "schedule.seconds=6",
+    "workers=1",
+]
+#: Flags for a quiet, offline headless Chromium (Playwright adds a fresh profile).
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+#: alt text of every figure of a full report.
+FIGURES = {
+    "film strip: human",
+    "film strip: robot before",
+    "film strip: robot after",
+    "learning curves",
+    "gyro traces",
+    "Fig. 3",
+    "Fig. 4",
+    "Fig. 6",
+    "Fig. 7",
+    "robustness",
+}
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return load_robot("hoap2")
+
+
+@pytest.fixture(scope="module")
+def run_dir(robot, tmp_path_factory):
+    """A tiny faithful run, evaluated (2 seeds × 6 s), with a two-cell robustness grid."""
+    cfg = RetargetConfig(search=False, scales=(0.3, 0.4), params=GaitParams(sway=0.9, ds=0.1))
+    ref = retarget(load_motion(default_clip()), robot, cfg).reference
+    out = tmp_path_factory.mktemp("report") / "run"
+    learn(ref, robot, apply_overrides(preset("faithful"), TINY), out)
+    argv = ["evaluate", str(out), "--seconds", "6", "--seeds", "2", "--workers", "1", "--json"]
+    assert main(argv) == 0
+    grid = robustness_grid(
+        out, robot, seconds=2.0, seeds=1, workers=1, cells=("nominal", "push_small")
+    )
+    RunDir(out).write_json("robustness.json", grid)
+    return out
+
+
+@pytest.fixture(scope="module")
+def report(run_dir, robot):
+    lines: list[str] = []
+    path = write_report(run_dir, robot, seconds=4.0, progress=lines.append)
+    return path, lines
+
+
+@pytest.fixture(scope="module")
+def bare_report(run_dir, robot, tmp_path_factory):
+    """The same run without evaluation.json and robustness.json, its mocap file gone."""
+    bare = tmp_path_factory.mktemp("bare") / "run"
+    shutil.copytree(
+        run_dir,
+        bare,
+        ignore=shutil.ignore_patterns(
+            "evaluation.json", "robustness.json", "report.html", "*.mp4", "*.png"
+        ),
+    )
+    ref = Reference.load(bare / "reference.npz")
+    ref.source = str(bare / "no_such_clip.bvh")
+    ref.save(bare / "reference.npz")
+    return write_report(bare, robot, seconds=2.0), None
+
+
+def test_report_is_self_contained(report):
+    path, lines = report
+    text = path.read_text()
+    assert path.name == "report.html" and lines and "wrote" in lines[-1]
+    links = re.findall(r"""(?:src|href)\s*=\s*["']([^"']*)""", text)
+    assert links and all(link.startswith("data:") for link in links), links
+    assert "http://" not in text and "https://" not in text
+    assert "<script" not in text.lower()
+    assert text.count("data:image/png;base64,") == len(FIGURES)
+    assert text.count("data:video/mp4;base64,") == 1
+    for needed in ("forward_distance_m", "push_small", "<details>", "Fig. 8"):
+        assert needed in text, needed
+    mp4 = path.with_name("before_after.mp4").read_bytes()
+    assert mp4[4:8] == b"ftyp" and b"avc1" in mp4  # an H.264 MP4
+    assert path.with_name("filmstrip.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_missing_files_are_said(bare_report):
+    text = bare_report[0].read_text()
+    assert "No <code>evaluation.json</code>" in text
+    assert "No <code>robustness.json</code>" in text
+    assert "the human motion could not be loaded" in text
+    assert "data:video/mp4;base64," in text
+
+
+def test_figures_take_empty_data(run_dir):
+    from imitwalk import curves, plots
+
+    lg = load_gait(run_dir)
+    figs = [
+        curves.learning_curves([]),
+        plots.fig6_optimized(lg.gait, lg.scale, []),
+        plots.fig7_schedule(lg.gait, []),
+        curves.gyro_traces([], [], 0.01),
+        curves.robustness_heatmap({"cells": {}}),
+        plots.film_strip([], []),
+    ]
+    for fig in figs:
+        assert plots.png_bytes(fig)[:4] == b"\x89PNG"
+
+
+def _chromium() -> str | None:
+    names = (os.environ.get("IMITWALK_CHROMIUM"), "chromium", "chromium-browser", "google-chrome")
+    return next((p for n in names if n and (p := shutil.which(n))), None)
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    exe = _chromium()
+    if exe is None:
+        pytest.skip("no Chromium binary found (apt-get install chromium, or set IMITWALK_CHROMIUM)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        pytest.fail(
+            "the browser test needs the playwright package (pip install playwright; "
+            "it drives the system Chromium, so never run `playwright install`)"
+        )
+    with sync_playwright() as pw:
+        profile = tmp_path_factory.mktemp("chromium-profile")
+        ctx = pw.chromium.launch_persistent_context(
+            str(profile),
+            executable_path=exe,
+            headless=True,
+            args=CHROMIUM_ARGS,
+            viewport={"width": 1200, "height": 900},
+            offline=True,
+        )
+        yield ctx
+        ctx.close()
+
+
+@pytest.mark.parametrize("which", ["report", "bare_report"])
+def test_report_in_a_real_browser(request, browser, which, tmp_path):
+    path = request.getfixturevalue(which)[0]
+    page = browser.new_page()
+    problems: list[str] = []
+    page.on(
+        "console",
+        lambda m: problems.append(f"console {m.type}: {m.text}") if m.type == "error" else None,
+    )
+    page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
+    page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url[:100]}"))
+    page.goto(path.resolve().as_uri(), wait_until="load")
+    ready = "(v => v.readyState >= 1 || v.error)(document.querySelector('video'))"
+    page.wait_for_function(ready, timeout=15_000)  # the video's metadata decoded, or failed
+    images = page.evaluate("""() => [...document.images].map(i => ({alt: i.alt,
+        natural: i.naturalWidth, w: i.getBoundingClientRect().width,
+        h: i.getBoundingClientRect().height, ok: i.complete}))""")
+    video = page.evaluate("""() => { const v = document.querySelector('video');
+        const r = v.getBoundingClientRect();
+        return {w: r.width, h: r.height, vw: v.videoWidth, vh: v.videoHeight,
+                duration: v.duration, error: v.error && v.error.code}; }""")
+    shot = tmp_path / f"{which}.png"
+    page.screenshot(path=str(shot), full_page=True)
+    page.close()
+    assert not problems, problems
+    alts = {i["alt"] for i in images}
+    expected = FIGURES if which == "report" else FIGURES - {"film strip: human", "robustness"}
+    assert alts == expected, alts ^ expected
+    for i in images:
+        assert i["ok"] and i["natural"] > 0 and i["w"] > 0 and i["h"] > 0, i
+    assert video["error"] is None and video["vw"] > 0 and video["duration"] > 0, video
+    assert video["w"] > 0 and video["h"] > 0, video
+    assert shot.stat().st_size > 10_000
