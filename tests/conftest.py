@@ -7,6 +7,15 @@ from pathlib import Path
 
 import pytest
 
+#: Settings of a tiny learning run (two scales, two short iterations each, one process).
+TINY = [
+    "schedule.start=0.3",
+    "schedule.stop=0.4",
+    "schedule.iterations=2",
+    "schedule.seconds=6",
+    "workers=1",
+]
+
 
 @pytest.fixture(scope="session")
 def shared_mocap() -> Path:
@@ -17,3 +26,25 @@ def shared_mocap() -> Path:
     if not path.is_dir():
         pytest.skip(f"shared mocap folder not found: {path} (set IMITWALK_SHARED_MOCAP)")
     return path
+
+
+@pytest.fixture(scope="session")
+def robot():
+    """The built-in HOAP-2-class robot."""
+    from imitwalk.robots import load_robot
+
+    return load_robot("hoap2")
+
+
+@pytest.fixture(scope="session")
+def tiny_reference(robot, tmp_path_factory):
+    """A walkable reference of the default clip at scales 0.3 and 0.4 (no search), and the
+    path it is saved at."""
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+
+    cfg = RetargetConfig(search=False, scales=(0.3, 0.4), params=GaitParams(sway=0.9, ds=0.1))
+    ref = retarget(load_motion(default_clip()), robot, cfg).reference
+    path = tmp_path_factory.mktemp("ref") / "ref.npz"
+    ref.save(path)
+    return ref, path

@@ -7,36 +7,12 @@ import json
 import numpy as np
 import pytest
 
+from conftest import TINY
 from imitwalk.cli import main
 from imitwalk.config import apply_overrides
 from imitwalk.learnconfig import preset
 from imitwalk.learner import learn
-from imitwalk.mocap import default_clip, load_motion
-from imitwalk.retarget import GaitParams, RetargetConfig, retarget
-from imitwalk.robots import load_robot
 from imitwalk.runs import RunDir
-
-TINY = [
-    "schedule.start=0.3",
-    "schedule.stop=0.4",
-    "schedule.iterations=2",
-    "schedule.seconds=6",
-    "workers=1",
-]
-
-
-@pytest.fixture(scope="module")
-def robot():
-    return load_robot("hoap2")
-
-
-@pytest.fixture(scope="module")
-def reference(robot, tmp_path_factory):
-    cfg = RetargetConfig(search=False, scales=(0.3, 0.4), params=GaitParams(sway=0.9, ds=0.1))
-    ref = retarget(load_motion(default_clip()), robot, cfg).reference
-    path = tmp_path_factory.mktemp("ref") / "ref.npz"
-    ref.save(path)
-    return ref, path
 
 
 def _strip(m: dict) -> dict:
@@ -44,8 +20,8 @@ def _strip(m: dict) -> dict:
 
 
 @pytest.mark.parametrize("variant", ["faithful", "extended"])
-def test_same_seed_same_result(tmp_path, robot, reference, variant):
-    ref, _ = reference
+def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
+    ref, _ = tiny_reference
     cfg = apply_overrides(preset(variant), [*TINY, "train_models=2"])
     a = learn(ref, robot, cfg, tmp_path / "a")
     b = learn(ref, robot, cfg, tmp_path / "b")
@@ -55,8 +31,8 @@ def test_same_seed_same_result(tmp_path, robot, reference, variant):
     assert strip(la) == strip(lb)
 
 
-def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, reference):
-    ref, _ = reference
+def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference):
+    ref, _ = tiny_reference
     cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2"])
     whole = learn(ref, robot, cfg, tmp_path / "whole")
     calls = []
@@ -77,8 +53,8 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, reference):
     assert [e["falls"] for e in rd.read_log()] == log_w
 
 
-def test_run_folder_contents(tmp_path, robot, reference):
-    ref, _ = reference
+def test_run_folder_contents(tmp_path, robot, tiny_reference):
+    ref, _ = tiny_reference
     cfg = apply_overrides(preset("faithful"), TINY)
     summary = learn(ref, robot, cfg, tmp_path / "run")
     rd = RunDir(tmp_path / "run")
@@ -110,10 +86,10 @@ def test_run_folder_contents(tmp_path, robot, reference):
     assert reports and {"rmse", "baseline_rmse", "ratio"} <= set(reports[0])
 
 
-def test_refuses_to_overwrite_and_to_resume_nothing(tmp_path, robot, reference):
+def test_refuses_to_overwrite_and_to_resume_nothing(tmp_path, robot, tiny_reference):
     from imitwalk.errors import RunError
 
-    ref, _ = reference
+    ref, _ = tiny_reference
     cfg = apply_overrides(preset("faithful"), [*TINY, "schedule.stop=0.3", "schedule.iterations=1"])
     with pytest.raises(RunError, match="nothing to resume"):
         learn(ref, robot, cfg, tmp_path / "x", resume=True)
@@ -122,8 +98,8 @@ def test_refuses_to_overwrite_and_to_resume_nothing(tmp_path, robot, reference):
         learn(ref, robot, cfg, tmp_path / "x")
 
 
-def test_cli_learn_and_evaluate(tmp_path, capsys, reference):
-    _, path = reference
+def test_cli_learn_and_evaluate(tmp_path, capsys, tiny_reference):
+    _, path = tiny_reference
     out = tmp_path / "run"
     argv = ["learn", "--reference", str(path), "--out", str(out), "--json"]
     argv += [a for s in TINY for a in ("--set", s)]

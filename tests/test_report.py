@@ -9,26 +9,17 @@ import shutil
 
 import pytest
 
+from conftest import TINY
 from imitwalk.cli import main
 from imitwalk.config import apply_overrides
 from imitwalk.evaluate import load_gait
 from imitwalk.learnconfig import preset
 from imitwalk.learner import learn
-from imitwalk.mocap import default_clip, load_motion
 from imitwalk.report import write_report
-from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.retarget.reference import Reference
-from imitwalk.robots import load_robot
 from imitwalk.robustness import robustness_grid
 from imitwalk.runs import RunDir
 
-TINY = [
-    "schedule.start=0.3",
-    "schedule.stop=0.4",
-    "schedule.iterations=2",
-    "schedule.seconds=6",
-    "workers=1",
-]
 #: Flags for a quiet, offline headless Chromium (Playwright adds a fresh profile).
 CHROMIUM_ARGS = [
     "--headless",
@@ -56,15 +47,9 @@ FIGURES = {
 
 
 @pytest.fixture(scope="module")
-def robot():
-    return load_robot("hoap2")
-
-
-@pytest.fixture(scope="module")
-def run_dir(robot, tmp_path_factory):
+def run_dir(robot, tiny_reference, tmp_path_factory):
     """A tiny faithful run, evaluated (2 seeds × 6 s), with a two-cell robustness grid."""
-    cfg = RetargetConfig(search=False, scales=(0.3, 0.4), params=GaitParams(sway=0.9, ds=0.1))
-    ref = retarget(load_motion(default_clip()), robot, cfg).reference
+    ref, _ = tiny_reference
     out = tmp_path_factory.mktemp("report") / "run"
     learn(ref, robot, apply_overrides(preset("faithful"), TINY), out)
     argv = ["evaluate", str(out), "--seconds", "6", "--seeds", "2", "--workers", "1", "--json"]

@@ -238,7 +238,7 @@ def demo(args: argparse.Namespace) -> int:
     from imitwalk.learner import learn as run_learn
     from imitwalk.mocap import default_clip, load_motion
     from imitwalk.report import write_report
-    from imitwalk.retarget import RetargetConfig
+    from imitwalk.retarget import Reference, RetargetConfig
     from imitwalk.retarget import retarget as do_retarget
     from imitwalk.robots import load_robot
     from imitwalk.runs import RunDir
@@ -247,28 +247,27 @@ def demo(args: argparse.Namespace) -> int:
     out = Path(args.out)
     robot = load_robot("hoap2")
     rd = RunDir(out)
-    if rd.exists("checkpoint.json") and not rd.exists("metrics.json"):
-        raise_resume = True
-    else:
-        raise_resume = False
+    lcfg = apply_overrides(preset("extended"), DEMO_LEARN)
     if rd.exists("metrics.json"):
         progress(f"demo: {out} already holds a finished run; reusing it")
     else:
-        motion = load_motion(default_clip())
-        progress(f"[1/4] retarget {Path(motion.source).name}: IK on the robot + parameter search")
-        cfg = apply_overrides(RetargetConfig(), DEMO_RETARGET)
-        ref = do_retarget(
-            motion,
-            robot,
-            cfg,
-            progress=lambda g, n, s, p: progress(f"      search {g}/{n}: best score {s:.3f}"),
-        ).reference
-        ref.settings["robot"] = "hoap2"
+        resume = rd.exists("checkpoint.json") and rd.exists("reference.npz")
+        if resume:
+            progress(f"[1/4] retarget: reusing the reference of the interrupted run in {out}")
+            ref = Reference.load(rd.file("reference.npz"))
+        else:
+            motion = load_motion(default_clip())
+            progress(f"[1/4] retarget {Path(motion.source).name}: IK on the robot + search")
+            cfg = apply_overrides(RetargetConfig(), DEMO_RETARGET)
+            ref = do_retarget(
+                motion,
+                robot,
+                cfg,
+                progress=lambda g, n, s, p: progress(f"      search {g}/{n}: best score {s:.3f}"),
+            ).reference
+            ref.settings["robot"] = "hoap2"
         progress("[2/4] learn (extended variant; demo schedule 0.5 -> 1.0)")
-        lcfg = apply_overrides(preset("extended"), DEMO_LEARN)
-        run_learn(
-            ref, robot, lcfg, out, resume=raise_resume, progress=lambda s: progress("      " + s)
-        )
+        run_learn(ref, robot, lcfg, out, resume=resume, progress=lambda s: progress("      " + s))
     progress("[3/4] evaluate: learned vs open loop on 4 robots x 20 s")
     ev = evaluate_run(out, robot, seconds=20.0, seeds=4)
     rd.write_json("evaluation.json", ev)

@@ -29,6 +29,7 @@ class ScheduleConfig:
         iterations: execute/record/retrain iterations per scale (the paper: three).
         seconds: simulated time per episode [s], start-up from standing included.
         retries: more attempts at a scale after a fall before learning stops.
+        consolidate: iterations at the scale reached once the schedule has stopped.
     """
 
     start: float = 0.3
@@ -37,6 +38,7 @@ class ScheduleConfig:
     iterations: int = 3
     seconds: float = 12.0
     retries: int = 3
+    consolidate: int = 0
 
     def scales(self) -> tuple[float, ...]:
         """The schedule's scales."""
@@ -108,7 +110,7 @@ VARIANTS: dict[str, LearnConfig] = {
     "extended": LearnConfig(
         variant="extended",
         gait=GaitConfig(n_components=6, phase_source="time"),
-        schedule=ScheduleConfig(seconds=16.0),
+        schedule=ScheduleConfig(seconds=16.0, consolidate=2),
         tick=TickConfig(enabled=False),
         steps=True,
         train_models=6,

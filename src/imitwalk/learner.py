@@ -4,7 +4,9 @@ Each iteration runs the current controller on the training robots (the nominal o
 for the extended variant training perturbations never used for evaluation), records the
 sensory-motor data, refits the models on everything recorded so far and moves along the
 scale schedule: a scale is passed when its last iteration (no exploration) walks without
-a fall on every training robot. After every iteration the run folder is checkpointed
+a fall on every training robot. When the schedule stops, a few consolidation iterations
+at the scale reached add on-policy data where the gait will be used (their falls are
+logged; they do not change the scale reached). After every iteration the run folder is checkpointed
 atomically, so ``resume`` continues an interrupted run and ends where an uninterrupted
 one would (same seed, same result).
 """
@@ -132,7 +134,10 @@ def learn(
         si, it = state["scale_index"], state["iteration"]
         scale = scales[si]
         models = fit_models(data, config)
+        polishing = state.get("consolidate_left") is not None
         explore = max(0.0, 1.0 - it / max(sch.iterations - 1, 1)) if sch.iterations > 1 else 0.0
+        if polishing:
+            explore = 0.0
         jobs = [
             (
                 robot,
@@ -153,22 +158,33 @@ def learn(
                 if kind in r and len(r[kind][0]) > 2:
                     data[kind].append(r[kind])
         entry = _iteration_log(scale, it, results, reports, t0)
+        entry["consolidation"] = polishing
         log.append(entry)
         fell = entry["falls"] > 0
         last = it >= sch.iterations - 1
-        if fell:
+        if polishing:
+            state["consolidate_left"] -= 1
+            state["done"] = state["consolidate_left"] <= 0
+        elif fell:
             state["failures"] += 1
             if state["failures"] > sch.retries:
                 state["done"] = True
         elif last:
             state["passed"].append(scale)
             state["failures"] = 0
-        if not state["done"]:
+        if polishing:
+            pass
+        elif not state["done"]:
             if last and not fell:
                 state["scale_index"], state["iteration"] = si + 1, 0
                 state["done"] = si + 1 >= len(scales)
             else:
                 state["iteration"] = min(it + 1, sch.iterations - 1)
+        if state["done"] and not polishing and state["passed"] and sch.consolidate > 0:
+            # the schedule has stopped: a few more iterations at the scale reached
+            state["done"], state["consolidate_left"] = False, sch.consolidate
+            state["scale_index"] = scales.index(max(state["passed"]))
+            state["iteration"] = sch.iterations - 1
         state["total_iterations"] += 1
         state["sim_seconds"] += entry["sim_seconds"]
         state["wall_seconds"] += entry["wall_seconds"]
