@@ -30,6 +30,8 @@ class ScheduleConfig:
         seconds: simulated time per episode [s], start-up from standing included.
         retries: more attempts at a scale after a fall before learning stops.
         consolidate: iterations at the scale reached once the schedule has stopped.
+        confirm: consecutive fall-free iterations without exploration that pass a scale
+            (the paper: one).
     """
 
     start: float = 0.3
@@ -39,6 +41,7 @@ class ScheduleConfig:
     seconds: float = 12.0
     retries: int = 3
     consolidate: int = 0
+    confirm: int = 1
 
     def scales(self) -> tuple[float, ...]:
         """The schedule's scales."""
@@ -110,7 +113,7 @@ VARIANTS: dict[str, LearnConfig] = {
     "extended": LearnConfig(
         variant="extended",
         gait=GaitConfig(n_components=6, phase_source="time"),
-        schedule=ScheduleConfig(seconds=16.0, consolidate=2),
+        schedule=ScheduleConfig(seconds=16.0, consolidate=2, confirm=2),
         tick=TickConfig(enabled=False),
         steps=True,
         train_models=6,

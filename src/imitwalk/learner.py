@@ -3,8 +3,8 @@
 Each iteration runs the current controller on the training robots (the nominal one, and
 for the extended variant training perturbations never used for evaluation), records the
 sensory-motor data, refits the models on everything recorded so far and moves along the
-scale schedule: a scale is passed when its last iteration (no exploration) walks without
-a fall on every training robot. When the schedule stops, a few consolidation iterations
+scale schedule: a scale is passed when its last ``confirm`` iterations (no exploration)
+walk without a fall on every training robot. When the schedule stops, a few consolidation iterations
 at the scale reached add on-policy data where the gait will be used (their falls are
 logged; they do not change the scale reached). After every iteration the run folder is checkpointed
 atomically, so ``resume`` continues an interrupted run and ends where an uninterrupted
@@ -167,15 +167,19 @@ def learn(
             state["done"] = state["consolidate_left"] <= 0
         elif fell:
             state["failures"] += 1
+            state["clean"] = 0
             if state["failures"] > sch.retries:
                 state["done"] = True
         elif last:
+            state["clean"] = state.get("clean", 0) + 1
+        passed = not polishing and last and not fell and state.get("clean", 0) >= sch.confirm
+        if passed:
             state["passed"].append(scale)
-            state["failures"] = 0
+            state["failures"] = state["clean"] = 0
         if polishing:
             pass
         elif not state["done"]:
-            if last and not fell:
+            if passed:
                 state["scale_index"], state["iteration"] = si + 1, 0
                 state["done"] = si + 1 >= len(scales)
             else:

@@ -148,6 +148,14 @@ class Replays:
     after: Rollout
     actions: np.ndarray
 
+    def postures(self, gait) -> np.ndarray:
+        """``(T, k)`` the learned run's commanded joint targets in the subspace, over its
+        last two gait cycles (up to its fall)."""
+        q = self.after.q_cmd
+        if self.after.fell:
+            q = q[: max(1, round(self.after.fall_time / self.after.control_dt))]
+        return gait.subspace.transform(q[-2 * gait.n_ticks :])
+
     @property
     def runs(self) -> list[tuple[str, Rollout]]:
         """(label, rollout) of each run, before first."""

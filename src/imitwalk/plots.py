@@ -151,9 +151,13 @@ def fig4_embedding(gait, scale: float) -> Figure:
     return fig
 
 
-def fig6_optimized(gait, scale: float, actions: np.ndarray) -> Figure:
+def fig6_optimized(
+    gait, scale: float, actions: np.ndarray, postures: np.ndarray | None = None
+) -> Figure:
     """Fig. 6: executed actions ``(T, 3)`` (φ, r, h), mapped by g into the subspace, against
-    the reference loop; beside, r and h of the actions against φ with g(φ)."""
+    the reference loop; beside, r and h of the actions against φ with g(φ). ``postures``
+    ``(T', 3)``, if given, are the executed joint targets projected by C (balance channels
+    included), drawn in green."""
     emb = gait.embedding(scale)
     A = np.asarray(actions, dtype=float).reshape(-1, 3)
     fig, ax, rh = _split(f"Optimised walking pattern in the subspace, scale {scale:g}")
@@ -164,6 +168,9 @@ def fig6_optimized(gait, scale: float, actions: np.ndarray) -> Figure:
         ax.scatter(*Y.T, s=6, color="red", label=f"optimised ({len(A)} ticks)")
     else:
         ax.set_title("no loop actions were executed", color="red", fontsize=9)
+    if postures is not None and len(postures):
+        P = np.asarray(postures, dtype=float)[:, :3]
+        ax.plot(*P.T, color="tab:green", lw=0.8, alpha=0.8, label="executed joint targets")
     _pc_labels(ax, gait)
     ax.legend(loc="upper left", fontsize=8)
     phi = np.linspace(0.0, TWO_PI, 200)

@@ -252,9 +252,11 @@ def _sections(
         (
             "Fig. 6: optimised pattern",
             _figure(
-                _img(plots.fig6_optimized(gait, scale, rp.actions), "Fig. 6"),
-                "The actions (φ, r, h) the learned "
-                "controller executed in the replay above (up to its fall, if it fell).",
+                _img(plots.fig6_optimized(gait, scale, rp.actions, rp.postures(gait)), "Fig. 6"),
+                "The actions (φ, r, h) the learned controller executed in the replay above "
+                "(red, up to its fall, if it fell); in green, the joint targets it actually "
+                "sent, projected into the subspace: they include the balance channels, which "
+                "act beside the subspace.",
             ),
         ),
         (

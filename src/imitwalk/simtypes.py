@@ -1,0 +1,111 @@
+"""The simulator layer's records: settings, one tick's observation, a whole run.
+
+Plain data (NumPy only), so code that judges or plots runs needs no MuJoCo.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Observation", "Rollout", "SimOptions"]
+
+
+@dataclass(frozen=True)
+class SimOptions:
+    """Simulation settings. Every perturbation defaults to off.
+
+    Attributes:
+        physics_hz: physics rate [Hz] (HOAP-2's servo loop runs at 1 kHz).
+        control_hz: rate at which joint targets are commanded [Hz].
+        gyro_noise: gyro noise standard deviation [rad/s].
+        accel_noise: accelerometer noise standard deviation [m/s²].
+        servo_delay: commands reach the servos this many control periods late.
+        friction: if set, the sliding friction coefficient of every contact.
+        friction_scale: multiplies every sliding friction coefficient.
+        mass_scale: multiplies every body mass and inertia.
+        mass_jitter: each body's mass also scaled by U(1 - j, 1 + j) (drawn from ``seed``).
+        kp_scale: multiplies every servo stiffness; kp_jitter: per servo U(1 - j, 1 + j).
+        slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
+        push_time, push_duration: when [s] and how long [s] the torso is pushed.
+        push_force: ``(3,)`` world-frame force on the torso during the push [N].
+        init_twist: ``(6,)`` initial base velocity, linear [m/s] then angular [rad/s].
+        seed: seeds sensor noise and jitter.
+        fall_height: a fall is the torso under this fraction of its standing height ...
+        fall_tilt_deg: ... or the torso tilted more than this [deg].
+    """
+
+    physics_hz: float = 1000.0
+    control_hz: float = 100.0
+    gyro_noise: float = 0.0
+    accel_noise: float = 0.0
+    servo_delay: int = 0
+    friction: float | None = None
+    friction_scale: float = 1.0
+    mass_scale: float = 1.0
+    mass_jitter: float = 0.0
+    kp_scale: float = 1.0
+    kp_jitter: float = 0.0
+    slope_deg: float = 0.0
+    push_time: float = 0.0
+    push_duration: float = 0.0
+    push_force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    init_twist: tuple[float, ...] = (0.0,) * 6
+    seed: int = 0
+    fall_height: float = 0.5
+    fall_tilt_deg: float = 45.0
+
+    @property
+    def substeps(self) -> int:
+        """Physics steps per control period."""
+        return max(1, round(self.physics_hz / self.control_hz))
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the robot measures at one control tick.
+
+    Attributes:
+        t: time [s]; gyro: ``(3,)`` torso angular velocity [rad/s], torso frame;
+        accel: ``(3,)`` torso specific force [m/s²]; foot_force: ``(2, k)`` normal
+        force per sole sensor [N], left row then right; joints: ``(n,)`` angles [rad].
+    """
+
+    t: float
+    gyro: np.ndarray
+    accel: np.ndarray
+    foot_force: np.ndarray
+    joints: np.ndarray
+
+
+@dataclass
+class Rollout:
+    """Everything recorded at each control tick of a run (``N`` ticks).
+
+    ``t`` (N,) [s]; ``q_cmd``/``q`` (N, n) commanded/measured joints [rad];
+    ``gyro``/``accel`` (N, 3); ``foot_force`` (N, 2, k) [N]; ``torso_pos`` (N, 3) [m]
+    and ``torso_quat`` (N, 4) (w, x, y, z) are simulator ground truth, for metrics
+    only; ``qpos`` (N, nq) for rendering. ``fell``/``fall_time`` [s] say whether and
+    when the torso fell; ``control_dt`` [s]; ``info`` holds per-run extras.
+    """
+
+    t: np.ndarray
+    q_cmd: np.ndarray
+    q: np.ndarray
+    gyro: np.ndarray
+    accel: np.ndarray
+    foot_force: np.ndarray
+    torso_pos: np.ndarray
+    torso_quat: np.ndarray
+    qpos: np.ndarray
+    fell: bool
+    fall_time: float | None
+    control_dt: float
+    joint_names: tuple[str, ...] = ()
+    info: dict = field(default_factory=dict)
+
+    @property
+    def seconds(self) -> float:
+        """Simulated time covered [s]."""
+        return len(self.t) * self.control_dt
