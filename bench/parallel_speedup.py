@@ -15,7 +15,6 @@ import numpy as np
 from mujoco import rollout
 
 from imitwalk.mocap import default_clip, load_motion
-from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed
 from imitwalk.playback import play_reference
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
@@ -69,8 +68,6 @@ def main() -> None:
     out["pool_speedup"] = round(out["pool_1_workers_s"] / out["pool_2_workers_s"], 2)
     print(json.dumps(out, indent=2))
 
-
-_ = run_parallel
 
 if __name__ == "__main__":
     main()

@@ -9,10 +9,6 @@ reached and are judged by the same :func:`~imitwalk.metrics.walk_metrics`.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
-import numpy as np
-
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.metrics import summarise, walk_metrics
@@ -148,6 +144,3 @@ def evaluate_run(
     out["open_loop"]["iterations"] = 0
     out["settings"] = {"seconds": seconds, "seeds": seeds, "scale": metrics.get("scale_reached")}
     return out
-
-
-_ = (np, replace)

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from imitwalk.retarget.ik import CHANNELS, WalkIK
+from imitwalk.retarget.ik import WalkIK
 from imitwalk.retarget.reference import UPPER, Reference
 from imitwalk.robots import Robot
 
@@ -54,10 +54,8 @@ class OnlineIK:
         )
 
     def __call__(self, k: int, offsets: np.ndarray) -> np.ndarray:
-        """Joint angles [rad] at tick ``k`` with ``offsets`` ``(8,)`` in ``CHANNELS`` order."""
+        """Joint angles [rad] at tick ``k`` with ``offsets`` ``(8,)`` in
+        :data:`imitwalk.retarget.ik.CHANNELS` order."""
         it = 30 if self._fresh else 10
         self._fresh = False
         return self.ik.solve_tick(self._tick_plan(k), 0, offsets, max_iter=it)
-
-
-_ = CHANNELS
