@@ -1,0 +1,41 @@
+"""The parallel map gives the same results on every executor."""
+
+from __future__ import annotations
+
+import pytest
+
+from imitwalk.errors import ConfigError
+from imitwalk.parallel import run_parallel
+
+
+def _square(x: int) -> int:
+    return x * x
+
+
+def test_process_pool_keeps_job_order():
+    assert run_parallel(_square, list(range(7)), workers=2) == [x * x for x in range(7)]
+    assert run_parallel(_square, list(range(3)), workers=1) == [0, 1, 4]
+
+
+def test_unknown_executor_lists_the_valid_ones(monkeypatch):
+    monkeypatch.setenv("IMITWALK_EXECUTOR", "dask")
+    with pytest.raises(ConfigError, match="valid: process, ray"):
+        run_parallel(_square, [1, 2])
+
+
+@pytest.mark.slow
+def test_ray_executor_runs_a_playback_sweep(monkeypatch, tiny_reference, robot):
+    pytest.importorskip("ray")
+    import ray
+
+    from imitwalk.playback import play_reference
+
+    ref, _ = tiny_reference
+    local = play_reference(ref, robot, 0.3, 2.0, [0, 1], workers=1)
+    monkeypatch.setenv("IMITWALK_EXECUTOR", "ray")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        remote = play_reference(ref, robot, 0.3, 2.0, [0, 1])
+    finally:
+        ray.shutdown()
+    assert [r.metrics for r in remote] == [r.metrics for r in local]
