@@ -90,3 +90,21 @@ def test_estimator_tilt_from_gravity_and_heading_from_gyro():
     assert e.roll == pytest.approx(roll, abs=1e-3) and abs(e.pitch) < 1e-6
     assert e.heading == pytest.approx(0.3, rel=1e-6)
     assert e.load_left == 1.0 and e.cop_x == pytest.approx(10.0 / 30.0)
+
+
+def test_search_stays_where_the_model_has_data_and_never_steps_inwards():
+    rng = np.random.default_rng(1)
+    S = [rng.normal(0, 0.05, (30, len(STEP_STATE))) for _ in range(4)]
+    A = [
+        np.c_[rng.uniform(-0.3, 0.3, (30, len(STEP_CHANNELS))) * ctrl_max(), np.ones(30)]
+        for _ in range(4)
+    ]
+    model = SensoryMotorModel(angle_action=False, linear=True, n_centers=4, ridge=1e-3)
+    model.fit(list(zip(S, A, strict=True)))
+    limits = 0.3 * ctrl_max()
+    ctrl = StepController(StepConfig(), 100, 0.1, model=model, limits=limits)
+    state = np.zeros(len(STEP_STATE))
+    for k in range(12):
+        c = ctrl.decide(state + rng.normal(0, 0.05, len(STEP_STATE)), k)
+        assert np.all(np.abs(c) <= limits + 1e-12)
+        assert c[STEP_CHANNELS.index("dy")] >= 0.0

@@ -64,6 +64,8 @@ class StepConfig:
     Attributes:
         channels: which of :data:`STEP_CHANNELS` the learner may use.
         c_max: box half-width per channel in :data:`STEP_CHANNELS` order [m, m, rad, m, m].
+            ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
+            apart, and a narrower step lands one foot on the other.
         weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
             on the deviation from the target state (the walk's own mean state, heading 0).
         effort: weight of Σ (c / c_max)² in the objective.
@@ -135,12 +137,16 @@ class StepController:
         explore: float = 0.0,
         scale: float = 1.0,
         target: np.ndarray | None = None,
+        limits: np.ndarray | None = None,
     ):
         self.config, self.n, self.ds, self.scale = config, n_ticks, ds, scale
         self.target = np.zeros(len(STEP_STATE)) if target is None else np.asarray(target, float)
         self.model, self.rng, self.explore = model, rng, explore
         self.mask = np.array([c in config.channels for c in STEP_CHANNELS], dtype=float)
         self.c_max = np.asarray(config.c_max, dtype=float) * self.mask
+        self.c_min = -self.c_max * (np.array(STEP_CHANNELS) != "dy")  # dy: outwards only
+        # the search stays where the model has seen data; exploration may go to the limits
+        self.box = self.c_max if limits is None else np.minimum(self.c_max, limits)
         self.states: list[np.ndarray] = []  # mirrored step states s_k
         self.actions: list[np.ndarray] = []  # channel values c_k (mirrored coordinates)
         self.predicted: list[float] = []
@@ -159,14 +165,15 @@ class StepController:
             self.predicted.append(pred)
         if self.rng is not None and self.explore > 0:
             c = c + self.explore * self.c_max * self.rng.uniform(-1.0, 1.0, len(c))
-        c = np.clip(c, -self.c_max, self.c_max)
+        c = np.clip(c, self.c_min, self.c_max)
         self.actions.append(c)
         return c
 
     def _search(self, s, s_prev, c_prev) -> tuple[np.ndarray, float]:
         cfg = self.config
         rng = np.random.default_rng(len(self.states))
-        cand = self.c_max * rng.uniform(-1.0, 1.0, (cfg.candidates, len(STEP_CHANNELS)))
+        lo = np.maximum(-self.box, self.c_min)
+        cand = rng.uniform(lo, self.box, (cfg.candidates, len(STEP_CHANNELS)))
         cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, 4)
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand

@@ -79,6 +79,15 @@ def fit_models(data: dict, config: LearnConfig) -> Models:
     return models
 
 
+def step_limits(models: Models, config: LearnConfig) -> np.ndarray | None:
+    """Per-channel search limits: where the step model has data (10 % beyond the largest
+    recorded value), never beyond ``c_max`` — the search must not extrapolate."""
+    if models.step is None or not models.step_data[1]:
+        return None
+    seen = np.abs(np.vstack(models.step_data[1])[:, :-1]).max(axis=0)
+    return np.minimum(np.asarray(config.step.c_max, dtype=float), 1.1 * seen)
+
+
 def build_policy(
     gait: GaitModel,
     scale: float,
@@ -132,6 +141,7 @@ def build_policy(
             explore=config.step.explore * explore,
             scale=scale,
             target=step_target(*models.step_data, scale) if models.step is not None else None,
+            limits=step_limits(models, config),
         )
     return WalkPolicy(
         gait,
