@@ -118,21 +118,7 @@ def test_unknown_setting(tmp_path, capsys):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "clip",
-    [
-        pytest.param(
-            "default",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="known open gap (issue 3): the default clip's reference walks 4 of 6 "
-                "at 0.5; two robots stay up but turn 16-25 degrees",
-            ),
-        ),
-        "cmu_bvh/07_04.bvh",
-        "cmu_bvh/07_06.bvh",
-    ],
-)
+@pytest.mark.parametrize("clip", ["default", "cmu_bvh/07_04.bvh", "cmu_bvh/07_06.bvh"])
 def test_reference_walks_open_loop_at_half_scale(shared_mocap, tmp_path, capsys, clip):
     """The issue's dynamics criterion: with its searched parameters, the reference walks
     open loop at scale 0.5 on at least 5 of 6 robots (nominal + 5 perturbed), 20 s each."""

@@ -12,6 +12,7 @@ QUICK = [
     "retarget.search_config.generations=1",
     "retarget.search_config.population=4",
     "retarget.search_config.seconds=6",
+    "retarget.search_config.models=2",
     "schedule.stop=0.5",
     "schedule.iterations=2",
     "schedule.seconds=8",

@@ -148,3 +148,20 @@ def test_paper_mapping_builds_and_reports_clipping(robot):
     assert np.all(ref.loops >= robot.limits[:, 0] - 1e-9)
     stats = res.stats()
     assert 0.0 < stats["clipped_fraction"] < 1.0 and stats["clipped"]
+
+
+def test_mid_swing_is_found_in_every_swing_whatever_the_sampling():
+    """Clearance is measured at the tick nearest σ = 0.5 of each swing, so a coarse or
+    uneven sampling of σ never leaves it undefined (it used to give NaN)."""
+    from imitwalk.retarget.checks import _mid_swing_ticks
+
+    stance = np.ones((40, 2), dtype=bool)
+    sigma = np.full((40, 2), np.nan)
+    stance[3:10, 0] = False
+    sigma[3:10, 0] = np.linspace(0.02, 0.97, 7)  # never within half a tick of 0.5
+    stance[20:33, 1] = False
+    sigma[20:33, 1] = np.linspace(0.0, 1.0, 13)
+    stance[37:, 0] = False  # a swing cut off by the end of the window
+    sigma[37:, 0] = [0.1, 0.2, 0.3]
+    ticks = _mid_swing_ticks(stance, sigma)
+    assert sorted(ticks) == [(6, 0), (26, 1), (39, 0)]

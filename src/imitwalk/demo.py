@@ -21,6 +21,7 @@ DEMO_RETARGET = [
     "search_config.generations=2",
     "search_config.population=6",
     "search_config.seconds=10",
+    "search_config.models=2",
 ]
 DEMO_LEARN = [
     "schedule.start=0.5",

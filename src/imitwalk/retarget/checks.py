@@ -32,6 +32,20 @@ def _closure(q: np.ndarray) -> float:
     return float(np.clip(np.abs(q[0] - q[-1]) - inner, 0.0, None).max())
 
 
+def _mid_swing_ticks(stance: np.ndarray, phase_sigma: np.ndarray) -> list[tuple[int, int]]:
+    """``(tick, foot)`` of the tick nearest σ = 0.5 in every swing (a run of ~stance ticks)."""
+    out = []
+    for j in range(stance.shape[1]):
+        swing = (~stance[:, j]).astype(int)
+        starts = np.flatnonzero(np.diff(np.r_[0, swing]) == 1)
+        ends = np.flatnonzero(np.diff(np.r_[swing, 0]) == -1) + 1
+        for a, b in zip(starts, ends, strict=True):
+            dist = np.abs(np.nan_to_num(phase_sigma[a:b, j], nan=np.inf) - 0.5)
+            if np.isfinite(dist).any():
+                out.append((a + int(np.argmin(dist)), j))
+    return out
+
+
 def kinematic_checks(
     robot: Robot, qpos: np.ndarray, stance: np.ndarray, phase_sigma: np.ndarray, q: np.ndarray
 ) -> dict:
@@ -62,8 +76,8 @@ def kinematic_checks(
             pos[i, j] = p
             tilt[i, j] = np.degrees(np.arccos(np.clip(rmat[2, 2], -1.0, 1.0)))
     stance_tilt = float(tilt[stance].max()) if stance.any() else 0.0
-    mid = np.abs(phase_sigma - 0.5) <= 0.5 / max(1, np.sum(~stance[:, 0]) // 2)
-    clearance = float(pos[:, :, 2][mid].min() * 1000) if mid.any() else float("nan")
+    mids = _mid_swing_ticks(stance, phase_sigma)
+    clearance = float(min(pos[i, j, 2] for i, j in mids) * 1000) if mids else float("nan")
     skate, landings = [], []
     for j in range(2):
         c = stance[:, j].astype(int)
