@@ -158,7 +158,7 @@ def test_mid_swing_is_found_in_every_swing_whatever_the_sampling():
     stance = np.ones((40, 2), dtype=bool)
     sigma = np.full((40, 2), np.nan)
     stance[3:10, 0] = False
-    sigma[3:10, 0] = np.linspace(0.02, 0.97, 7)  # never within half a tick of 0.5
+    sigma[3:10, 0] = np.linspace(0.02, 0.97, 7)  # coarse: no tick at exactly 0.5
     stance[20:33, 1] = False
     sigma[20:33, 1] = np.linspace(0.0, 1.0, 13)
     stance[37:, 0] = False  # a swing cut off by the end of the window
