@@ -174,7 +174,7 @@ class StepController:
         rng = np.random.default_rng(len(self.states))
         lo = np.maximum(-self.box, self.c_min)
         cand = rng.uniform(lo, self.box, (cfg.candidates, len(STEP_CHANNELS)))
-        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, 4)
+        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, 5)
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand
         seq[:, :, -1] = self.scale  # the model also sees the stride scale

@@ -4,11 +4,11 @@ Each iteration runs the current controller on the training robots (the nominal o
 for the extended variant training perturbations never used for evaluation), records the
 sensory-motor data, refits the models on everything recorded so far and moves along the
 scale schedule: a scale is passed when its last ``confirm`` iterations (no exploration)
-walk without a fall on every training robot. When the schedule stops, a few consolidation iterations
-at the scale reached add on-policy data where the gait will be used (their falls are
-logged; they do not change the scale reached). After every iteration the run folder is checkpointed
-atomically, so ``resume`` continues an interrupted run and ends where an uninterrupted
-one would (same seed, same result).
+walk without a fall on every training robot. When the schedule stops, a few
+consolidation iterations at the scale reached add on-policy data where the gait will be
+used (their falls are logged; they do not change the scale reached). After every
+iteration the run folder is checkpointed atomically, so ``resume`` continues an
+interrupted run and ends where an uninterrupted one would (same seed, same result).
 """
 
 from __future__ import annotations
@@ -135,9 +135,9 @@ def learn(
         scale = scales[si]
         models = fit_models(data, config)
         polishing = state.get("consolidate_left") is not None
-        explore = max(0.0, 1.0 - it / max(sch.iterations - 1, 1)) if sch.iterations > 1 else 0.0
-        if polishing:
-            explore = 0.0
+        explore = 0.0
+        if sch.iterations > 1 and not polishing:
+            explore = max(0.0, 1.0 - it / (sch.iterations - 1))
         jobs = [
             (
                 robot,
@@ -176,9 +176,7 @@ def learn(
         if passed:
             state["passed"].append(scale)
             state["failures"] = state["clean"] = 0
-        if polishing:
-            pass
-        elif not state["done"]:
+        if not polishing and not state["done"]:
             if passed:
                 state["scale_index"], state["iteration"] = si + 1, 0
                 state["done"] = si + 1 >= len(scales)
