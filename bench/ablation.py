@@ -31,6 +31,7 @@ VARIANTS = {
     "no foot placement (dx, dy, yaw)": ("extended", ["step.channels=sway,lean"]),
     "no turn channel": ("extended", ["step.channels=dx,dy,sway,lean"]),
     "one-step horizon": ("extended", ["step.horizon=1"]),
+    "one step model (no ensemble)": ("extended", ["step.ensemble=1"]),
     "k = 3 components": ("extended", ["gait.n_components=3"]),
     "faithful (the paper)": ("faithful", []),
 }

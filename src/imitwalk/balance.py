@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.controller import stability_cost
+from imitwalk.ensemble import ModelEnsemble
 from imitwalk.predictor import SensoryMotorModel
 
 __all__ = [
@@ -73,6 +74,10 @@ class StepConfig:
         candidates: random candidates per decision (plus the nominal zero).
         explore: exploration noise, a fraction of c_max, in the first iteration at a scale.
         n_centers, ridge: of the step model's RBF network (which also has linear terms).
+        ensemble: step models fitted to bootstrap resamples of the recorded episodes
+            (:class:`~imitwalk.ensemble.ModelEnsemble`); a candidate is scored by its
+            predicted gain over the zero channels in the least favourable one (1: one
+            model on all the data, scored as it predicts).
     """
 
     channels: tuple[str, ...] = STEP_CHANNELS
@@ -84,6 +89,7 @@ class StepConfig:
     explore: float = 0.3
     n_centers: int = 24
     ridge: float = 1e-2
+    ensemble: int = 1
 
 
 def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: float) -> np.ndarray:
@@ -132,7 +138,7 @@ class StepController:
         config: StepConfig,
         n_ticks: int,
         ds: float,
-        model: SensoryMotorModel | None = None,
+        model: ModelEnsemble | SensoryMotorModel | None = None,
         rng: np.random.Generator | None = None,
         explore: float = 0.0,
         scale: float = 1.0,
@@ -178,13 +184,15 @@ class StepController:
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand
         seq[:, :, -1] = self.scale  # the model also sees the stride scale
-        pred = self.model.rollout(s, s_prev, seq, c_prev)  # (M, H, ds)
+        pred = self.model.rollout_members(s, s_prev, seq, c_prev)  # (E, M, H, ds)
         w = np.asarray(cfg.weights, dtype=float)
         scale = np.where(self.c_max > 0, self.c_max, 1.0)
-        dev = pred - self.target
-        cost = stability_cost(dev, w).sum(axis=1) + cfg.effort * np.sum((cand / scale) ** 2, 1)
-        best = int(np.argmin(cost))
-        return cand[best], float(cost[best])
+        cost = stability_cost(pred - self.target, w).sum(axis=-1)  # (E, M)
+        cost = cost + cfg.effort * np.sum((cand / scale) ** 2, 1)
+        # each member's predicted gain over the nominal (zero) channels; the worst decides
+        worst = (cost - cost[:, :1]).max(axis=0)
+        best = int(np.argmin(worst))
+        return cand[best], float(cost[:, best].mean())
 
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:

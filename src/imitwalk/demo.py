@@ -29,6 +29,7 @@ DEMO_LEARN = [
     "schedule.seconds=10",
     "train_models=2",
     "schedule.confirm=1",
+    "schedule.retries=3",
     "schedule.consolidate=0",
 ]
 

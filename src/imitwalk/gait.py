@@ -33,11 +33,16 @@ class GaitConfig:
         phase_source: ``"angle"`` (the paper's φ, the data's angle about z_θ) or ``"time"``
             (the reference's time phase, robust where the angle runs backwards).
         n_centers: kernels of the periodic fit g(φ) (eq. 2).
+        residual: add back, as a fixed function of the phase, what the representation
+            does not reproduce of the reference (the posture outside the subspace, and the
+            error of the cylinder's round trip), so that the nominal action reproduces the
+            reference exactly; actions still move the posture only within the subspace.
     """
 
     n_components: int = 3
     phase_source: str = "angle"
     n_centers: int = 24
+    residual: bool = False
 
 
 class GaitModel:
@@ -60,6 +65,7 @@ class GaitModel:
         self.subspace = PostureSubspace(config.n_components).fit(loops)
         self.embeddings: dict[float, GaitEmbedding] = {}
         self.nominal: dict[float, np.ndarray] = {}
+        self.residuals: dict[float, np.ndarray] = {}
         for s, loop in zip(self.scales, loops, strict=True):
             X = self.subspace.transform(loop)  # (N, k)
             emb = GaitEmbedding(n_centers=config.n_centers, phase_source=config.phase_source)
@@ -68,6 +74,10 @@ class GaitModel:
             cyl = emb.to_cylinder(X)  # (N, 3)
             cyl[:, 0] = np.unwrap(cyl[:, 0])
             self.nominal[s] = cyl
+            # what the representation does not reproduce: the subspace's truncation and
+            # the cylinder's round trip (with the time phase, its angle is a fit of φ)
+            back = np.array([emb.from_cylinder(c) for c in cyl])
+            self.residuals[s] = loop - self.subspace.inverse_transform(back)  # (N, n)
 
     @property
     def n_ticks(self) -> int:
@@ -95,8 +105,26 @@ class GaitModel:
 
     def joints(self, scale: float, action: np.ndarray) -> np.ndarray:
         """Joint targets ``(n,)`` [rad] of an action (φ, r, h): g and C⁺ (the way back)."""
-        x = self.embedding(scale).from_cylinder(np.asarray(action, dtype=float))
-        return self.subspace.inverse_transform(x)
+        action = np.asarray(action, dtype=float)
+        q = self.subspace.inverse_transform(self.embedding(scale).from_cylinder(action))
+        if self.config.residual:
+            q = q + self._residual_at(scale, float(action[0]))
+        return q
+
+    def _residual_at(self, scale: float, phi: float) -> np.ndarray:
+        """The out-of-subspace posture ``(n,)`` at phase φ, interpolated between ticks."""
+        key = self._key(scale)
+        nom, res = self.nominal[key][:, 0], self.residuals[key]
+        sign = 1.0 if nom[-1] >= nom[0] else -1.0
+        table = np.maximum.accumulate(sign * (nom - nom[0]))  # ascending from 0
+        u = (sign * (phi - nom[0])) % (2 * np.pi)
+        t = float(np.interp(u, table, np.arange(len(nom)), right=np.nan))
+        if not np.isfinite(t):  # between the last tick and the next cycle's first
+            span = 2 * np.pi - table[-1]
+            t = len(nom) - 1 + ((u - table[-1]) / span if span > 0 else 0.0)
+        i = int(np.floor(t))
+        w = t - i
+        return (1.0 - w) * res[i % len(res)] + w * res[(i + 1) % len(res)]
 
     def phase_step(self, scale: float) -> float:
         """Mean φ advance per tick of the nominal loop [rad]."""

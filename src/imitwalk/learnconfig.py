@@ -3,9 +3,11 @@
 ``faithful`` is the paper as written: k = 3 principal components, the data's angle as
 the phase, the 2nd-order RBF model of the gyro, and the per-tick predictive search in
 the local box of eqs. 9–13, learned on the nominal robot. ``extended`` keeps that
-structure and adds, each as its own option: k = 6, the time phase, the step-level
-balance channels with their own step model and search (:mod:`imitwalk.balance`), and
-training on perturbed robots as well as the nominal one.
+structure and adds, each as its own option: k = 6, the time phase, the reference's
+posture outside the subspace added back (so the nominal action is the reference), the step-level
+balance channels with their own step model and search (:mod:`imitwalk.balance`), a
+bootstrap ensemble of step models that the search must all convince
+(:mod:`imitwalk.ensemble`), and training on perturbed robots as well as the nominal one.
 """
 
 from __future__ import annotations
@@ -88,6 +90,8 @@ class LearnConfig:
         gait: representation; schedule: scales; tick: the paper's per-tick search.
         steps: use the step-level balance channels; step: their settings.
         train_models: robots per iteration: the nominal one + training perturbations.
+        fresh_robots: draw new training perturbations at every iteration (else the same
+            ones throughout); a scale then passes only on robots it has not learned on.
         seed: random seed; workers: parallel processes (``None``: one per core).
     """
 
@@ -98,6 +102,7 @@ class LearnConfig:
     steps: bool = True
     step: StepConfig = field(default_factory=StepConfig)
     train_models: int = 3
+    fresh_robots: bool = False
     seed: int = 0
     workers: int | None = None
 
@@ -112,11 +117,13 @@ VARIANTS: dict[str, LearnConfig] = {
     ),
     "extended": LearnConfig(
         variant="extended",
-        gait=GaitConfig(n_components=6, phase_source="time"),
-        schedule=ScheduleConfig(seconds=16.0, consolidate=2, confirm=2),
+        gait=GaitConfig(n_components=6, phase_source="time", residual=True),
+        schedule=ScheduleConfig(seconds=16.0, retries=6, consolidate=2, confirm=2),
         tick=TickConfig(enabled=False),
         steps=True,
+        step=StepConfig(ensemble=5),
         train_models=6,
+        fresh_robots=True,
     ),
 }
 

@@ -1,7 +1,8 @@
 """The learning loop (paper §5 steps 3–7, §6): execute, record, retrain, re-optimise, scale up.
 
 Each iteration runs the current controller on the training robots (the nominal one, and
-for the extended variant training perturbations never used for evaluation), records the
+for the extended variant training perturbations never used for evaluation — new ones at
+every iteration with ``fresh_robots``), records the
 sensory-motor data, refits the models on everything recorded so far and moves along the
 scale schedule: a scale is passed when its last ``confirm`` iterations (no exploration)
 walk without a fall on every training robot. When the schedule stops, a few
@@ -25,6 +26,7 @@ from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.models import build_policy, fit_models, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
+from imitwalk.perturb import train_seeds
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
@@ -42,7 +44,8 @@ def _episode(job) -> dict:
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
     steps = round(cfg.schedule.seconds / ref.dt)
-    ro = run(MujocoPlant(robot, perturbed(seed, disturbance=seed != 0)), policy, steps)
+    plant = MujocoPlant(robot, perturbed(seed, disturbance=seed != 0))
+    ro = run(plant, policy, steps, q0=policy.q0)
     m = walk_metrics(
         ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
     )
@@ -68,6 +71,7 @@ def _iteration_log(scale, it, results, reports, t0) -> dict:
         "scale": scale,
         "iteration": it,
         "robots": len(results),
+        "seeds": [r["seed"] for r in results],
         "falls": int(sum(m["fell"] for m in ms)),
         "fell": [m["fell"] for m in ms],
         "fall_time_s": [m["fall_time_s"] for m in ms],
@@ -127,7 +131,6 @@ def learn(
         log, data = [], {"tick": [], "step": []}
     scales = config.schedule.scales()
     gait = GaitModel(ref, scales, config.gait)
-    seeds = (0, *range(1001, 1000 + config.train_models))
     sch = config.schedule
     while not state["done"]:
         t0 = time.perf_counter()
@@ -135,6 +138,8 @@ def learn(
         scale = scales[si]
         models = fit_models(data, config)
         polishing = state.get("consolidate_left") is not None
+        draw = state["total_iterations"] if config.fresh_robots else 0
+        seeds = train_seeds(config.train_models, draw)
         explore = 0.0
         if sch.iterations > 1 and not polishing:
             explore = max(0.0, 1.0 - it / (sch.iterations - 1))

@@ -171,9 +171,11 @@ def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Repl
     q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
     before = playback(MujocoPlant(robot, SimOptions()), q_ref, q0=q_ref[0], stop_on_fall=False)
     policy = lg.policy(robot, scale)
-    after = run(MujocoPlant(robot, SimOptions()), policy, len(q_ref), stop_on_fall=False)
+    after = run(
+        MujocoPlant(robot, SimOptions()), policy, len(q_ref), q0=policy.q0, stop_on_fall=False
+    )
     actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
-    if after.fell:  # the loop's actions start one cycle before the start-up ends
-        first = len(lg.ref.at_scale(scale)[0]) - lg.gait.n_ticks
+    if after.fell:
+        first = policy.first_loop_tick
         actions = actions[: max(0, round(after.fall_time / after.control_dt) - first)]
     return Replays(scale, before, after, actions)

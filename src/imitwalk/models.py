@@ -15,6 +15,7 @@ import numpy as np
 
 from imitwalk.balance import StepController, step_target
 from imitwalk.controller import ActionSelector
+from imitwalk.ensemble import ModelEnsemble
 from imitwalk.errors import RunError
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
@@ -32,7 +33,7 @@ class Models:
     """The fitted models (``None`` where there is no data yet or the part is off)."""
 
     tick: SensoryMotorModel | None = None
-    step: SensoryMotorModel | None = None
+    step: ModelEnsemble | None = None
     step_data: tuple = ((), ())
 
     def held_out(self, results: list[dict]) -> dict:
@@ -68,12 +69,13 @@ def fit_models(data: dict, config: LearnConfig) -> Models:
         ).fit(_latest(tick_eps, MAX_TICK_SAMPLES))
     step_eps = [e for e in data.get("step", []) if len(e[0]) > 3]
     if config.steps and sum(len(e[0]) for e in step_eps) >= 30:
-        models.step = SensoryMotorModel(
+        models.step = ModelEnsemble(
+            n_members=config.step.ensemble,
+            random_state=config.seed,
             n_centers=config.step.n_centers,
             ridge=config.step.ridge,
             angle_action=False,
             linear=True,
-            random_state=config.seed,
         ).fit(step_eps)
     models.step_data = ([e[0] for e in step_eps], [e[1] for e in step_eps])
     return models

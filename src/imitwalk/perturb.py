@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from imitwalk.sim import SimOptions
+from imitwalk.simtypes import SimOptions
 
 __all__ = ["TRAIN_SEED_BASE", "perturbed", "train_seeds"]
 
@@ -47,6 +47,11 @@ def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = Fal
     )
 
 
-def train_seeds(n: int) -> tuple[int, ...]:
-    """``n`` robots for learning: the nominal one, then training perturbations."""
-    return (0, *range(TRAIN_SEED_BASE + 1, TRAIN_SEED_BASE + n))
+def train_seeds(n: int, draw: int = 0) -> tuple[int, ...]:
+    """``n`` robots for learning: the nominal one, then ``n - 1`` training perturbations.
+
+    ``draw`` picks a set: draw 0 is seeds ``TRAIN_SEED_BASE + 1 …``, draw k the k-th set
+    of ``n - 1`` fresh ones after it (a learner that meets new robots every iteration).
+    """
+    first = TRAIN_SEED_BASE + 1 + draw * max(n - 1, 0)
+    return (0, *range(first, first + n - 1))

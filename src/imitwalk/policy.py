@@ -8,7 +8,9 @@ offsets, solved exactly by the robot's IK (an injected ``channel_ik(tick, offset
 e.g. :class:`imitwalk.retarget.online.OnlineIK`), from the first step of the start-up
 on; the joint change it makes is added to the controller's output. Over the last
 start-up cycle the output is cross-faded from the start-up trajectory to the
-controller's. It records what the learner trains on.
+controller's, unless the gait adds its residual back (then the controller's nominal
+output is the reference, which continues the start-up exactly, and the start-up is
+played to its end). It records what the learner trains on.
 """
 
 from __future__ import annotations
@@ -66,6 +68,17 @@ class WalkPolicy:
         self._step_k = 0
         self._gyro_sum, self._gyro_n = np.zeros(4), 0
 
+    @property
+    def first_loop_tick(self) -> int:
+        """The first tick at which the paper's controller acts (its actions are recorded
+        from here on): the start of the cross-fade cycle, or the end of the start-up."""
+        return len(self.start) - (0 if self.gait.config.residual else self.n)
+
+    @property
+    def q0(self) -> np.ndarray:
+        """``(n,)`` the posture the controller starts from (the start-up's first)."""
+        return self.start[0]
+
     def _tick_state(self, est) -> np.ndarray:
         if self.tick_state == "full":
             return np.array([*est.gyro, est.roll, est.pitch])
@@ -74,7 +87,7 @@ class WalkPolicy:
     def __call__(self, k: int, obs) -> np.ndarray:
         est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
         m, n = len(self.start), self.n
-        if k < m - n:
+        if k < self.first_loop_tick:
             q = self.start[k].copy()
         else:
             i = k - m  # loop tick; negative during the cross-fade cycle

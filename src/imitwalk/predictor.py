@@ -20,7 +20,7 @@ from sklearn.utils.validation import check_is_fitted
 from imitwalk.errors import ConfigError
 from imitwalk.rbf import RBFNetwork
 
-__all__ = ["PredictionReport", "SensoryMotorModel", "encode_action"]
+__all__ = ["PredictionReport", "SensoryMotorModel", "encode_action", "prediction_report"]
 
 Episode = tuple[np.ndarray, np.ndarray]
 
@@ -191,6 +191,11 @@ class SensoryMotorModel(BaseEstimator):
             s, s_prev, a_prev = out[:, h], s, actions[:, h]
         return out
 
+    def rollout_members(self, s_t, s_tm1, actions, a_tm1) -> np.ndarray:
+        """:meth:`rollout` as a one-member ensemble: ``(1, M, H, ds)``
+        (the interface of :class:`~imitwalk.ensemble.ModelEnsemble`)."""
+        return self.rollout(s_t, s_tm1, actions, a_tm1)[None]
+
     def evaluate(self, episodes: Sequence[Episode]) -> PredictionReport:
         """One-step errors on ``episodes`` against the no-action baseline s_{t+1} ≈ s_t."""
         check_is_fitted(self)
@@ -199,21 +204,29 @@ class SensoryMotorModel(BaseEstimator):
             raise ValueError(
                 f"episodes have (ds, da) = {dims}, the model {self.n_state_, self.n_action_}"
             )
-        pred = self.network_.predict(alpha) + (s_t if self.predict_delta else 0.0)
-        err, base = pred - s_next, s_t - s_next  # (N, ds)
-        sst = np.sum((s_next - s_next.mean(axis=0)) ** 2, axis=0)
-        sst = np.where(sst > 0, sst, np.nan)
-        rmse = np.sqrt(np.mean(err**2, axis=0))
-        brmse = np.sqrt(np.mean(base**2, axis=0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = rmse / brmse
-            overall = float(np.sqrt(np.mean(err**2)) / np.sqrt(np.mean(base**2)))
-        return PredictionReport(
-            n_samples=len(alpha),
-            rmse=rmse,
-            baseline_rmse=brmse,
-            r2=1.0 - np.sum(err**2, axis=0) / sst,
-            baseline_r2=1.0 - np.sum(base**2, axis=0) / sst,
-            ratio=ratio,
-            overall_ratio=overall,
-        )
+        return prediction_report(self._predict_alpha(alpha, s_t), s_t, s_next)
+
+    def _predict_alpha(self, alpha: np.ndarray, s_t: np.ndarray) -> np.ndarray:
+        """s_{t+1} from network inputs α ``(N, p)`` (as built by :meth:`_tuples`)."""
+        return self.network_.predict(alpha) + (s_t if self.predict_delta else 0.0)
+
+
+def prediction_report(pred: np.ndarray, s_t: np.ndarray, s_next: np.ndarray) -> PredictionReport:
+    """Errors of predictions ``pred`` ``(N, ds)`` of ``s_next`` against s_{t+1} ≈ s_t."""
+    err, base = pred - s_next, s_t - s_next  # (N, ds)
+    sst = np.sum((s_next - s_next.mean(axis=0)) ** 2, axis=0)
+    sst = np.where(sst > 0, sst, np.nan)
+    rmse = np.sqrt(np.mean(err**2, axis=0))
+    brmse = np.sqrt(np.mean(base**2, axis=0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = rmse / brmse
+        overall = float(np.sqrt(np.mean(err**2)) / np.sqrt(np.mean(base**2)))
+    return PredictionReport(
+        n_samples=len(pred),
+        rmse=rmse,
+        baseline_rmse=brmse,
+        r2=1.0 - np.sum(err**2, axis=0) / sst,
+        baseline_r2=1.0 - np.sum(base**2, axis=0) / sst,
+        ratio=ratio,
+        overall_ratio=overall,
+    )
