@@ -74,11 +74,8 @@ def _robustness_table(rob: dict) -> str:
             for m in ("learned", "open_loop")
         )
         rows.append(f"<tr><th>{html.escape(name)}</th>{cells}</tr>")
-    return (
-        "<table><tr><th>cell</th><th>learned</th><th>open loop</th></tr>"
-        + "".join(rows)
-        + "</table>"
-    )
+    head = "<table><tr><th>cell</th><th>learned</th><th>open loop</th></tr>"
+    return head + "".join(rows) + "</table>"
 
 
 STYLE = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}

@@ -35,13 +35,7 @@ from imitwalk.mocap.motion import KEYPOINTS, Motion
 __all__ = ["UNITS", "read_bvh"]
 
 #: Length units a BVH may use -> metres per unit.
-UNITS: dict[str, float] = {
-    "m": 1.0,
-    "cm": 0.01,
-    "mm": 0.001,
-    "inch": 0.0254,
-    "cmu": 0.0254 / 0.45,
-}
+UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.0254 / 0.45}
 
 #: Standing hip height [m] of an adult, used to guess the units.
 HIP_HEIGHT_M = 0.9
@@ -282,19 +276,16 @@ def read_bvh(
         and not np.all(values[1, is_rot] == np.round(values[1, is_rot]))
     )
     skip = tpose if skip_tpose is None else skip_tpose
-    if skip:
-        values = values[1:]
+    values = values[1:] if skip else values
     if len(values) < 1:
         raise MocapError(f"{src}: no motion frames")
     kp_joint = _keypoint_joints(joints, src)
     up, hip_height = _rest_leg(joints, kp_joint["l_hip"], kp_joint["l_ankle"], src)
-    if units is None:
+    guessed = units is None
+    if guessed:
         if hip_height <= 0:
             raise MocapError(f"{src}: cannot guess units (rest-pose hip height {hip_height})")
         units = min(UNITS, key=lambda u: abs(np.log(hip_height * UNITS[u] / HIP_HEIGHT_M)))
-        guessed = True
-    else:
-        guessed = False
     pos = z_up(_forward_kinematics(joints, values, UNITS[units]), up)
     keypoints = check_keypoints({k: pos[:, j] for k, j in kp_joint.items()}, src, len(values))
     meta = {
