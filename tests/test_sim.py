@@ -134,3 +134,22 @@ def test_slope_tilts_gravity_and_loads_the_feet_less(robot):
 def test_initial_twist(robot):
     _, ro = _hold(robot, 0.05, init_twist=(0.0, 0.0, 0.0, 0.5, 0.0, 0.0))
     assert abs(ro.gyro[0, 0]) > 0.1
+
+
+def test_a_policy_that_declares_its_start_posture_starts_there(robot):
+    from imitwalk.sim import run
+
+    bent = robot.stand.copy()
+    bent[robot.joint_names.index("l_knee")] += 0.2
+
+    class Hold:
+        q0 = bent
+
+        def __call__(self, k, obs):
+            return bent
+
+    declared = run(MujocoPlant(robot), Hold(), 20)
+    explicit = playback(MujocoPlant(robot), np.tile(bent, (20, 1)), q0=bent)
+    assert np.array_equal(declared.q, explicit.q)
+    standing = run(MujocoPlant(robot), lambda k, obs: bent, 20)  # no q0: standing
+    assert not np.array_equal(standing.q, declared.q)

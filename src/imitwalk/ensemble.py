@@ -80,11 +80,6 @@ class ModelEnsemble(BaseEstimator):
         """The members' mean rollout, ``(M, H, ds)``."""
         return self.rollout_members(s_t, s_tm1, actions, a_tm1).mean(axis=0)
 
-    def predict(self, s_t, s_tm1, a_t, a_tm1) -> np.ndarray:
-        """The members' mean one-step prediction (shapes as the member's ``predict``)."""
-        check_is_fitted(self)
-        return np.mean([m.predict(s_t, s_tm1, a_t, a_tm1) for m in self.members_], axis=0)
-
     def evaluate(self, episodes) -> PredictionReport:
         """One-step errors of the mean prediction against the no-action baseline."""
         check_is_fitted(self)

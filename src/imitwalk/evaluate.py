@@ -75,8 +75,7 @@ def _one(job) -> dict:
     steps = round(seconds / lg.ref.dt)
     q_ref = lg.ref.trajectory(scale, seconds)
     if mode == "learned":
-        policy = lg.policy(robot, scale)
-        ro = run(MujocoPlant(robot, opts), policy, steps, q0=policy.q0)
+        ro = run(MujocoPlant(robot, opts), lg.policy(robot, scale), steps)
     else:
         ro = playback(MujocoPlant(robot, opts), q_ref, q0=q_ref[0])
     m = walk_metrics(ro, lg.ref.expected_distance(scale, ro.seconds), q_ref)

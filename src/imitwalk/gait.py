@@ -66,6 +66,7 @@ class GaitModel:
         self.embeddings: dict[float, GaitEmbedding] = {}
         self.nominal: dict[float, np.ndarray] = {}
         self.residuals: dict[float, np.ndarray] = {}
+        self._phase_tables: dict[float, tuple[float, np.ndarray]] = {}
         for s, loop in zip(self.scales, loops, strict=True):
             X = self.subspace.transform(loop)  # (N, k)
             emb = GaitEmbedding(n_centers=config.n_centers, phase_source=config.phase_source)
@@ -76,8 +77,13 @@ class GaitModel:
             self.nominal[s] = cyl
             # what the representation does not reproduce: the subspace's truncation and
             # the cylinder's round trip (with the time phase, its angle is a fit of φ)
+            # (row by row, as :meth:`joints` maps one action; batched, the round trip
+            # differs in the last bit, and a marginal robot's fate can hang on that)
             back = np.array([emb.from_cylinder(c) for c in cyl])
             self.residuals[s] = loop - self.subspace.inverse_transform(back)  # (N, n)
+            sign = 1.0 if cyl[-1, 0] >= cyl[0, 0] else -1.0
+            table = np.maximum.accumulate(sign * (cyl[:, 0] - cyl[0, 0]))  # ascending from 0
+            self._phase_tables[s] = (sign, table)
 
     @property
     def n_ticks(self) -> int:
@@ -114,14 +120,12 @@ class GaitModel:
     def _residual_at(self, scale: float, phi: float) -> np.ndarray:
         """The out-of-subspace posture ``(n,)`` at phase φ, interpolated between ticks."""
         key = self._key(scale)
-        nom, res = self.nominal[key][:, 0], self.residuals[key]
-        sign = 1.0 if nom[-1] >= nom[0] else -1.0
-        table = np.maximum.accumulate(sign * (nom - nom[0]))  # ascending from 0
-        u = (sign * (phi - nom[0])) % (2 * np.pi)
-        t = float(np.interp(u, table, np.arange(len(nom)), right=np.nan))
+        res, (sign, table) = self.residuals[key], self._phase_tables[key]
+        u = (sign * (phi - self.nominal[key][0, 0])) % (2 * np.pi)
+        t = float(np.interp(u, table, np.arange(len(table)), right=np.nan))
         if not np.isfinite(t):  # between the last tick and the next cycle's first
             span = 2 * np.pi - table[-1]
-            t = len(nom) - 1 + ((u - table[-1]) / span if span > 0 else 0.0)
+            t = len(table) - 1 + ((u - table[-1]) / span if span > 0 else 0.0)
         i = int(np.floor(t))
         w = t - i
         return (1.0 - w) * res[i % len(res)] + w * res[(i + 1) % len(res)]

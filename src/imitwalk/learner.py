@@ -44,8 +44,7 @@ def _episode(job) -> dict:
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
     steps = round(cfg.schedule.seconds / ref.dt)
-    plant = MujocoPlant(robot, perturbed(seed, disturbance=seed != 0))
-    ro = run(plant, policy, steps, q0=policy.q0)
+    ro = run(MujocoPlant(robot, perturbed(seed, disturbance=seed != 0)), policy, steps)
     m = walk_metrics(
         ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
     )

@@ -171,9 +171,7 @@ def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Repl
     q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
     before = playback(MujocoPlant(robot, SimOptions()), q_ref, q0=q_ref[0], stop_on_fall=False)
     policy = lg.policy(robot, scale)
-    after = run(
-        MujocoPlant(robot, SimOptions()), policy, len(q_ref), q0=policy.q0, stop_on_fall=False
-    )
+    after = run(MujocoPlant(robot, SimOptions()), policy, len(q_ref), stop_on_fall=False)
     actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
     if after.fell:
         first = policy.first_loop_tick

@@ -76,7 +76,8 @@ class WalkPolicy:
 
     @property
     def q0(self) -> np.ndarray:
-        """``(n,)`` the posture the controller starts from (the start-up's first)."""
+        """``(n,)`` the posture the controller starts from (the start-up's first);
+        :func:`imitwalk.sim.run` resets the robot to it."""
         return self.start[0]
 
     def _tick_state(self, est) -> np.ndarray:

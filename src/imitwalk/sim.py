@@ -176,11 +176,16 @@ def run(
     """Run ``policy(tick, obs) -> (n,) targets`` for ``steps`` control periods.
 
     Args:
-        plant: the simulated robot (reset here to ``q0``, standing if ``None``).
+        plant: the simulated robot (reset here to ``q0``).
         policy: called once per tick with the tick index and the latest observation.
         steps: number of control periods to run.
+        q0: ``(n,)`` starting posture [rad]; ``None``: the policy's own ``q0`` if it
+            declares one (a controller starts where its trajectory starts, as open-loop
+            playback of that trajectory does), else standing.
         stop_on_fall: end the run at the first fall.
     """
+    if q0 is None:
+        q0 = getattr(policy, "q0", None)
     obs = plant.reset(q0)
     n, nq = len(plant.joint_names), plant.model.nq
     rec = {k: [] for k in ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos")}
