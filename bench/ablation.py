@@ -32,6 +32,7 @@ VARIANTS = {
     "no turn channel": ("extended", ["step.channels=dx,dy,sway,lean"]),
     "one-step horizon": ("extended", ["step.horizon=1"]),
     "one step model (no ensemble)": ("extended", ["step.ensemble=1"]),
+    "no gain trials (gain 1)": ("extended", ["gains="]),
     "k = 3 components": ("extended", ["gait.n_components=3"]),
     "faithful (the paper)": ("faithful", []),
 }

@@ -13,6 +13,8 @@ TINY = [
     "schedule.stop=0.4",
     "schedule.iterations=2",
     "schedule.seconds=6",
+    "gain_robots=2",
+    "gain_seconds=4",
     "workers=1",
 ]
 

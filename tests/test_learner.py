@@ -16,7 +16,11 @@ from imitwalk.runs import RunDir
 
 
 def _strip(m: dict) -> dict:
-    return {k: v for k, v in m.items() if k != "wall_seconds_for_learning"}
+    """A summary without its wall times (the one thing a rerun may change)."""
+    out = {k: v for k, v in m.items() if k != "wall_seconds_for_learning"}
+    if out.get("gain_trials"):
+        out["gain_trials"] = {k: v for k, v in out["gain_trials"].items() if k != "wall_seconds"}
+    return out
 
 
 @pytest.mark.parametrize("variant", ["faithful", "extended"])
@@ -26,6 +30,14 @@ def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
     a = learn(ref, robot, cfg, tmp_path / "a")
     b = learn(ref, robot, cfg, tmp_path / "b")
     assert _strip(a) == _strip(b)
+    if variant == "extended":  # the gain trials ran on their own robots, every candidate
+        from imitwalk.perturb import trial_seeds
+
+        trials = a["gain_trials"]
+        assert trials["seeds"] == list(trial_seeds(2)) and a["channel_gain"] == trials["gain"]
+        assert [r["gain"] for r in trials["table"]] == list(cfg.gains)
+    else:
+        assert a["gain_trials"] is None and a["channel_gain"] == 1.0
     la, lb = RunDir(tmp_path / "a").read_log(), RunDir(tmp_path / "b").read_log()
     strip = lambda log: [{k: v for k, v in e.items() if k != "wall_seconds"} for e in log]  # noqa: E731
     assert strip(la) == strip(lb)
@@ -55,6 +67,24 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
     seeds = [e["seeds"] for e in rd.read_log()]
     assert seeds == [e["seeds"] for e in RunDir(tmp_path / "whole").read_log()]
     assert all(s[0] == 0 for s in seeds) and seeds[0][1:] != seeds[1][1:]
+
+
+def test_a_run_interrupted_in_its_gain_trials_resumes_to_the_same_end(
+    tmp_path, robot, tiny_reference
+):
+    ref, _ = tiny_reference
+    cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2", "schedule.stop=0.3"])
+    whole = learn(ref, robot, cfg, tmp_path / "whole")
+
+    def interrupt(line):
+        if line.startswith("channel gain 0.5"):
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
+    assert "gain" not in RunDir(tmp_path / "cut").read_json("checkpoint.json")
+    resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
+    assert _strip(resumed) == _strip(whole)
 
 
 def test_training_robot_draws_never_overlap_or_meet_an_evaluation_robot():
@@ -142,6 +172,19 @@ def test_cli_learn_and_evaluate(tmp_path, capsys, tiny_reference):
         assert set(ev["learned"][k]) == {"mean", "min", "max"}
     assert RunDir(out).exists("evaluation.json")
     assert np.isfinite(ev["open_loop"]["forward_distance_m"]["mean"])
+    cmp = ev["comparison"]
+    assert cmp["robots"] == 2 and 0.0 < cmp["mcnemar_p"] <= 1.0
+    assert cmp["learned_fall_rate"] == ev["learned"]["falls"] / 2
+    # the channel gain the trials kept is the one evaluation replays
+    from imitwalk.evaluate import load_gait
+
+    kept = RunDir(out).read_json("metrics.json")["channel_gain"]
+    assert kept in (0.0, 0.5, 1.0) and load_gait(out).config.step.gain == kept
+    # judged at another scale: its own file, the scale recorded
+    argv += ["--scale", "0.3"]
+    assert main(argv) == 0
+    at = json.loads(capsys.readouterr().out)
+    assert at["settings"]["scale"] == 0.3 and RunDir(out).exists("evaluation_scale0.3.json")
 
 
 def test_evaluate_a_folder_that_is_not_a_run(tmp_path, capsys):

@@ -17,6 +17,8 @@ QUICK = [
     "schedule.iterations=2",
     "schedule.seconds=8",
     "train_models=2",
+    "gain_robots=3",
+    "gain_seconds=8",
 ]
 
 
@@ -35,6 +37,9 @@ def test_learn_and_evaluate_every_walk(shared_mocap, tmp_path, capsys, clip, var
     ev = json.loads(capsys.readouterr().out)
     assert ev["learned"]["seeds"] == ev["open_loop"]["seeds"] == 3
     assert ev["open_loop"]["scale_reached"] == learned["scale_reached"]
+    assert ev["comparison"]["robots"] == 3
+    if variant == "extended" and learned["scale_reached"] > 0:
+        assert learned["channel_gain"] == learned["gain_trials"]["gain"] in (0.0, 0.5, 1.0)
 
 
 @pytest.mark.slow

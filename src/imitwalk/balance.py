@@ -32,6 +32,7 @@ import numpy as np
 
 from imitwalk.controller import stability_cost
 from imitwalk.ensemble import ModelEnsemble
+from imitwalk.errors import ConfigError
 from imitwalk.predictor import SensoryMotorModel
 
 __all__ = [
@@ -78,6 +79,13 @@ class StepConfig:
             (:class:`~imitwalk.ensemble.ModelEnsemble`); a candidate is scored by its
             predicted gain over the zero channels in the least favourable one (1: one
             model on all the data, scored as it predicts).
+        margin: act only if every member predicts a gain over the zero channels of at
+            least this fraction of the zero channels' own predicted cost (0: any gain).
+            The model is least trustworthy where its predicted gains are small; a
+            margin keeps the walk on the reference there.
+        gain: the channel values the search chooses are multiplied by this (a trust
+            factor on the model's corrections: 1 applies them as predicted, 0 turns them
+            off). The learner can pick it from measured trials (``LearnConfig.gains``).
     """
 
     channels: tuple[str, ...] = STEP_CHANNELS
@@ -90,6 +98,14 @@ class StepConfig:
     n_centers: int = 24
     ridge: float = 1e-2
     ensemble: int = 1
+    margin: float = 0.0
+    gain: float = 1.0
+
+    def __post_init__(self):
+        if not 0.0 <= self.margin < 1.0:
+            raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
+        if not 0.0 <= self.gain <= 2.0:
+            raise ConfigError(f"step.gain={self.gain}: expected 0 <= gain <= 2")
 
 
 def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: float) -> np.ndarray:
@@ -168,6 +184,7 @@ class StepController:
         c = np.zeros(len(STEP_CHANNELS))
         if self.model is not None and len(self.states) >= 2 and len(self.actions) >= 1:
             c, pred = self._search(s, self.states[-2], np.r_[self.actions[-1], self.scale])
+            c = self.config.gain * c
             self.predicted.append(pred)
         if self.rng is not None and self.explore > 0:
             c = c + self.explore * self.c_max * self.rng.uniform(-1.0, 1.0, len(c))
@@ -192,6 +209,8 @@ class StepController:
         # each member's predicted gain over the nominal (zero) channels; the worst decides
         worst = (cost - cost[:, :1]).max(axis=0)
         best = int(np.argmin(worst))
+        if worst[best] > -cfg.margin * cost[:, 0].mean():  # not a clear enough gain
+            best = 0
         return cand[best], float(cost[:, best].mean())
 
     # -- task offsets ---------------------------------------------------------

@@ -119,6 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("run_dir", help="a run folder written by learn")
     ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
     ev.add_argument("--seeds", type=int, default=10, help="robots: nominal + perturbed (10)")
+    ev.add_argument(
+        "--scale", type=float, default=None, help="judge at this scale (default: the one reached)"
+    )
     ev.add_argument("--perturb", action="store_true", help="run the robustness grid instead")
     ev.add_argument("--robot", default=None, help="robot (default: the run's)")
     ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")

@@ -184,6 +184,8 @@ def learn(args: argparse.Namespace) -> int:
         "iterations",
         "sim_seconds_used_for_learning",
         "wall_seconds_for_learning",
+        "channel_gain",
+        "gain_trials",
     )
     out = {k: summary[k] for k in keys}
     out["run_dir"] = str(rd.path)
@@ -204,13 +206,23 @@ def evaluate(args: argparse.Namespace) -> int:
     if args.perturb:
         progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
         out = robustness_grid(
-            rd.path, robot, args.seconds, args.seeds, workers=args.workers, progress=progress
+            rd.path,
+            robot,
+            args.seconds,
+            args.seeds,
+            workers=args.workers,
+            progress=progress,
+            scale=args.scale,
         )
-        rd.write_json("robustness.json", out)
+        name = "robustness.json" if args.scale is None else f"robustness_scale{args.scale:g}.json"
+        rd.write_json(name, out)
     else:
         progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
-        out = evaluate_run(rd.path, robot, args.seconds, args.seeds, workers=args.workers)
-        rd.write_json("evaluation.json", out)
+        out = evaluate_run(
+            rd.path, robot, args.seconds, args.seeds, workers=args.workers, scale=args.scale
+        )
+        name = "evaluation.json" if args.scale is None else f"evaluation_scale{args.scale:g}.json"
+        rd.write_json(name, out)
     emit(out, args.json)
     return 0
 

@@ -30,7 +30,7 @@ def _coerce(text: str, current: Any, key: str) -> Any:
         if isinstance(current, float):
             return float(text)
         if isinstance(current, tuple):
-            items = json.loads(text) if text.startswith("[") else text.split(",")
+            items = json.loads(text) if text.startswith("[") else text.split(",") if text else []
             kind = type(current[0]) if current else float
             return tuple(kind(x) for x in items)
         if current is None:

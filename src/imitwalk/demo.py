@@ -31,6 +31,8 @@ DEMO_LEARN = [
     "schedule.confirm=1",
     "schedule.retries=3",
     "schedule.consolidate=0",
+    "gain_robots=3",
+    "gain_seconds=12",
 ]
 
 

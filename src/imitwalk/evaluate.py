@@ -9,6 +9,11 @@ reached and are judged by the same :func:`~imitwalk.metrics.walk_metrics`.
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
+
+from scipy.stats import binomtest
+
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.metrics import summarise, walk_metrics
@@ -20,7 +25,7 @@ from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim import MujocoPlant, SimOptions, playback, run
 
-__all__ = ["LearnedGait", "evaluate_run", "load_gait", "per_seed"]
+__all__ = ["LearnedGait", "compare_falls", "evaluate_run", "load_gait", "per_seed", "wilson"]
 
 KEYS = (
     "forward_distance_m",
@@ -38,6 +43,8 @@ class LearnedGait:
     """Everything needed to replay a run's learned controller (rebuilt from its folder)."""
 
     def __init__(self, ref: Reference, config: LearnConfig, data: dict, metrics: dict):
+        gain = metrics.get("channel_gain", config.step.gain)  # picked by the gain trials
+        config = replace(config, step=replace(config.step, gain=float(gain)))
         self.ref, self.config, self.metrics = ref, config, metrics
         self.scale = float(metrics["scale_reached"]) or config.schedule.start
         self.gait = GaitModel(ref, config.schedule.scales(), config.gait)
@@ -126,6 +133,41 @@ def _summary(runs: list[dict], metrics: dict) -> dict:
     return out
 
 
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a rate ``k / n`` (``(0, 1)`` when ``n`` is 0)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    mid = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    lo = 0.0 if k == 0 else max(0.0, mid - half)  # exact ends (not rounding residue)
+    hi = 1.0 if k == n else min(1.0, mid + half)
+    return lo, hi
+
+
+def compare_falls(learned: list[bool], open_loop: list[bool]) -> dict:
+    """Falls of the two controllers on the same robots, as a paired comparison.
+
+    Returns the fall rates with their 95 % Wilson intervals, the discordant robots
+    (``learned_only``: fell learned but not open loop; ``open_only``: the reverse) and
+    the two-sided exact McNemar p-value (a binomial test on the discordant robots) of
+    "learning changes the fall rate". Ten robots rarely decide it: a 0/10 against 2/10
+    has p = 0.5.
+    """
+    if len(learned) != len(open_loop):
+        raise ValueError("compare_falls: the two lists must cover the same robots")
+    n = len(learned)
+    lo = sum(1 for a, b in zip(learned, open_loop, strict=True) if a and not b)
+    oo = sum(1 for a, b in zip(learned, open_loop, strict=True) if b and not a)
+    p = float(binomtest(lo, lo + oo, 0.5).pvalue) if lo + oo else 1.0
+    out = {"robots": n, "learned_only": lo, "open_only": oo, "mcnemar_p": p}
+    for name, fell in (("learned", learned), ("open_loop", open_loop)):
+        k = int(sum(fell))
+        out[f"{name}_fall_rate"] = k / n if n else 0.0
+        out[f"{name}_fall_rate_ci95"] = list(wilson(k, n))
+    return out
+
+
 def evaluate_run(
     run_dir,
     robot: Robot,
@@ -133,14 +175,24 @@ def evaluate_run(
     seeds: int = 10,
     workers=None,
     base: SimOptions | None = None,
+    scale: float | None = None,
 ) -> dict:
     """``{"learned": ..., "open_loop": ...}`` with the same keys (per-seed figures as
-    ``{"mean", "min", "max"}``); open loop is the reference at the same scale."""
+    ``{"mean", "min", "max"}``); open loop is the reference at the same scale.
+    ``"comparison"`` holds the paired fall comparison (:func:`compare_falls`).
+    ``scale``: judge both at this scale instead of the one the run reached."""
     metrics = RunDir(run_dir).read_json("metrics.json")
-    res = per_seed(run_dir, robot, seconds, list(range(seeds)), base, workers)
+    res = per_seed(run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale)
     out = {mode: _summary(runs, metrics) for mode, runs in res.items()}
     out["open_loop"]["sim_seconds_used_for_learning"] = 0.0
     out["open_loop"]["wall_seconds_for_learning"] = 0.0
     out["open_loop"]["iterations"] = 0
-    out["settings"] = {"seconds": seconds, "seeds": seeds, "scale": metrics.get("scale_reached")}
+    out["comparison"] = compare_falls(
+        [bool(r["fell"]) for r in res["learned"]], [bool(r["fell"]) for r in res["open_loop"]]
+    )
+    out["settings"] = {
+        "seconds": seconds,
+        "seeds": seeds,
+        "scale": scale or metrics.get("scale_reached"),
+    }
     return out

@@ -7,7 +7,8 @@ structure and adds, each as its own option: k = 6, the time phase, the reference
 posture outside the subspace added back (so the nominal action is the reference), the step-level
 balance channels with their own step model and search (:mod:`imitwalk.balance`), a
 bootstrap ensemble of step models that the search must all convince
-(:mod:`imitwalk.ensemble`), and training on perturbed robots as well as the nominal one.
+(:mod:`imitwalk.ensemble`), training on perturbed robots as well as the nominal one, and
+the channel gain picked by measured trials (:mod:`imitwalk.trust`).
 """
 
 from __future__ import annotations
@@ -92,6 +93,9 @@ class LearnConfig:
         train_models: robots per iteration: the nominal one + training perturbations.
         fresh_robots: draw new training perturbations at every iteration (else the same
             ones throughout); a scale then passes only on robots it has not learned on.
+        gains: candidate channel gains tried once the schedule has ended, each on the
+            same ``gain_robots`` robots for ``gain_seconds``; the one that measures best
+            is kept (:mod:`imitwalk.trust`). Empty: keep ``step.gain``.
         seed: random seed; workers: parallel processes (``None``: one per core).
     """
 
@@ -103,8 +107,17 @@ class LearnConfig:
     step: StepConfig = field(default_factory=StepConfig)
     train_models: int = 3
     fresh_robots: bool = False
+    gains: tuple[float, ...] = ()
+    gain_robots: int = 12
+    gain_seconds: float = 24.0
     seed: int = 0
     workers: int | None = None
+
+    def __post_init__(self):
+        if any(not 0.0 <= g <= 2.0 for g in self.gains):
+            raise ConfigError(f"gains={list(self.gains)}: each must be 0 <= gain <= 2")
+        if self.gains and self.gain_robots < 1:
+            raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 
 
 VARIANTS: dict[str, LearnConfig] = {
@@ -124,6 +137,7 @@ VARIANTS: dict[str, LearnConfig] = {
         step=StepConfig(ensemble=5),
         train_models=6,
         fresh_robots=True,
+        gains=(0.0, 0.5, 1.0),
     ),
 }
 

@@ -7,7 +7,9 @@ sensory-motor data, refits the models on everything recorded so far and moves al
 scale schedule: a scale is passed when its last ``confirm`` iterations (no exploration)
 walk without a fall on every training robot. When the schedule stops, a few
 consolidation iterations at the scale reached add on-policy data where the gait will be
-used (their falls are logged; they do not change the scale reached). After every
+used (their falls are logged; they do not change the scale reached). With ``gains``, the
+channel-gain trials then decide how much of the learned correction to apply
+(:mod:`imitwalk.trust`); they are checkpointed too. After every
 iteration the run folder is checkpointed atomically, so ``resume`` continues an
 interrupted run and ends where an uninterrupted one would (same seed, same result).
 """
@@ -15,7 +17,7 @@ interrupted run and ends where an uninterrupted one would (same seed, same resul
 from __future__ import annotations
 
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 
 import numpy as np
 
@@ -26,10 +28,11 @@ from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.models import build_policy, fit_models, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
-from imitwalk.perturb import train_seeds
+from imitwalk.perturb import train_seeds, trial_seeds
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
+from imitwalk.trust import tune_gain
 
 __all__ = ["learn"]
 
@@ -40,10 +43,10 @@ def _episode(job) -> dict:
     from imitwalk.perturb import perturbed
     from imitwalk.sim import MujocoPlant, run
 
-    robot, gait, scale, cfg, models, seed, explore, rng_seed = job
+    robot, gait, scale, cfg, models, seed, explore, rng_seed, seconds = job
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
-    steps = round(cfg.schedule.seconds / ref.dt)
+    steps = round(seconds / ref.dt)
     ro = run(MujocoPlant(robot, perturbed(seed, disturbance=seed != 0)), policy, steps)
     m = walk_metrics(
         ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
@@ -152,6 +155,7 @@ def learn(
                 s,
                 explore,
                 [config.seed, state["total_iterations"], j],
+                sch.seconds,
             )
             for j, s in enumerate(seeds)
         ]
@@ -199,6 +203,12 @@ def learn(
         rd.write_json("checkpoint.json", state)
         if progress:
             progress(_progress_line(entry))
+    if config.gains and config.steps and state["passed"] and "gain" not in state:
+        choice = _tune(gait, robot, config, data, max(state["passed"]), progress)
+        state["gain"] = choice.to_dict()
+        state["sim_seconds"] += choice.sim_seconds
+        state["wall_seconds"] += choice.wall_seconds
+        rd.write_json("checkpoint.json", state)
     summary = {
         "variant": config.variant,
         "scale_reached": max(state["passed"]) if state["passed"] else 0.0,
@@ -206,11 +216,32 @@ def learn(
         "iterations": state["total_iterations"],
         "sim_seconds_used_for_learning": state["sim_seconds"],
         "wall_seconds_for_learning": state["wall_seconds"],
+        "channel_gain": state["gain"]["gain"] if "gain" in state else config.step.gain,
+        "gain_trials": state.get("gain"),
         "gait": gait.report(),
         "config": asdict(config),
     }
     rd.write_json("metrics.json", summary)
     return summary
+
+
+def _tune(gait, robot, config: LearnConfig, data, scale: float, progress):
+    """The channel-gain trials at the scale reached (:func:`imitwalk.trust.tune_gain`)."""
+    t0 = time.perf_counter()
+    models = fit_models(data, config)
+
+    def episodes(gain: float, seeds) -> list[dict]:
+        cfg = replace(config, step=replace(config.step, gain=gain))
+        jobs = [
+            (robot, gait, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
+            for j, s in enumerate(seeds)
+        ]
+        return [r["metrics"] for r in run_parallel(_episode, jobs, config.workers)]
+
+    choice = tune_gain(episodes, config.gains, trial_seeds(config.gain_robots), progress)
+    if progress:
+        progress(f"channel gain kept: {choice.gain:g}")
+    return replace(choice, wall_seconds=time.perf_counter() - t0)
 
 
 def _progress_line(e: dict) -> str:

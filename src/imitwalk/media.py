@@ -65,6 +65,16 @@ def outcome(ro: Rollout) -> str:
     return f"{fell}; torso moved {d:+.2f} m along x in {ro.seconds:.1f} s"
 
 
+def gain(metrics: dict) -> str:
+    """The channel gain of a run's ``metrics.json``, and its trials if any ran, in a phrase."""
+    out = f"channel gain {metrics.get('channel_gain', 1.0):g}"
+    trials = metrics.get("gain_trials")
+    if not trials:
+        return out
+    rows = ", ".join(f"{r['gain']:g}: {r['falls']} fell" for r in trials["table"])
+    return f"{out} (trials on {len(trials['seeds'])} robots: {rows})"
+
+
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
     from PIL import Image, ImageDraw, ImageFont
 

@@ -4,7 +4,8 @@ Seed 0 is the nominal robot. Every other seed draws a perturbed one: each body's
 ±5 %, the floor friction 0.7-1.0, each servo's stiffness ±10 %, and (for the
 evaluation of a learned gait) a small initial disturbance of the base velocity.
 Evaluation seeds are 0-99; learning and the reference search only use seeds from
-:data:`TRAIN_SEED_BASE` up, so they never see an evaluation robot.
+:data:`TRAIN_SEED_BASE` up, so they never see an evaluation robot; the learner's trials
+of its channel gain use seeds from :data:`TRIAL_SEED_BASE` up, robots it never learned on.
 """
 
 from __future__ import annotations
@@ -15,10 +16,13 @@ import numpy as np
 
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["TRAIN_SEED_BASE", "perturbed", "train_seeds"]
+__all__ = ["TRAIN_SEED_BASE", "TRIAL_SEED_BASE", "perturbed", "train_seeds", "trial_seeds"]
 
 #: Seeds at or above this are reserved for learning and searching.
 TRAIN_SEED_BASE = 1000
+#: Seeds at or above this are the gain trials' (:mod:`imitwalk.trust`); learning's draws
+#: stay below it (they would need ~10⁵ training robots to reach it).
+TRIAL_SEED_BASE = 100_000
 
 
 def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = False) -> SimOptions:
@@ -55,3 +59,9 @@ def train_seeds(n: int, draw: int = 0) -> tuple[int, ...]:
     """
     first = TRAIN_SEED_BASE + 1 + draw * max(n - 1, 0)
     return (0, *range(first, first + n - 1))
+
+
+def trial_seeds(n: int) -> tuple[int, ...]:
+    """``n`` robots for the gain trials: the nominal one, then ``n - 1`` perturbations that
+    neither learning nor evaluation uses."""
+    return (0, *range(TRIAL_SEED_BASE + 1, TRIAL_SEED_BASE + n))

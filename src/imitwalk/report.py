@@ -219,7 +219,7 @@ def _sections(
             _figure(
                 _img(curves.learning_curves(log), "learning curves"),
                 f"{len(log)} iterations; {m.get('sim_seconds_used_for_learning')} s simulated; "
-                f"scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}.",
+                f"scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}; {media.gain(m)}.",
             ),
         ),
         (

@@ -55,8 +55,10 @@ def robustness_grid(
     workers=None,
     progress=None,
     cells: tuple[str, ...] | None = None,
+    scale: float | None = None,
 ) -> dict:
-    """Survival and distance per cell, learned vs open loop.
+    """Survival and distance per cell, learned vs open loop (at ``scale``, default the
+    scale the run reached).
 
     Returns:
         ``{"cells": {name: {"learned": {...}, "open_loop": {...}}}, "totals": {...}}`` where
@@ -65,9 +67,11 @@ def robustness_grid(
     """
     grid = _cells(seconds)
     names = cells or tuple(grid)
-    out: dict = {"seconds": seconds, "seeds": seeds, "cells": {}}
+    out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "cells": {}}
     for name in names:
-        res = per_seed(run_dir, robot, seconds, list(range(seeds)), grid[name], workers)
+        res = per_seed(
+            run_dir, robot, seconds, list(range(seeds)), grid[name], workers, scale=scale
+        )
         row = {}
         for mode, runs in res.items():
             row[mode] = {
