@@ -9,7 +9,6 @@ reached and are judged by the same :func:`~imitwalk.metrics.walk_metrics`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 from scipy.stats import binomtest
@@ -133,16 +132,12 @@ def _summary(runs: list[dict], metrics: dict) -> dict:
     return out
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+def wilson(k: int, n: int) -> tuple[float, float]:
     """95 % Wilson score interval of a rate ``k / n`` (``(0, 1)`` when ``n`` is 0)."""
     if n == 0:
         return 0.0, 1.0
-    p = k / n
-    mid = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    lo = 0.0 if k == 0 else max(0.0, mid - half)  # exact ends (not rounding residue)
-    hi = 1.0 if k == n else min(1.0, mid + half)
-    return lo, hi
+    ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 def compare_falls(learned: list[bool], open_loop: list[bool]) -> dict:

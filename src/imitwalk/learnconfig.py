@@ -114,8 +114,8 @@ class LearnConfig:
     workers: int | None = None
 
     def __post_init__(self):
-        if any(not 0.0 <= g <= 2.0 for g in self.gains):
-            raise ConfigError(f"gains={list(self.gains)}: each must be 0 <= gain <= 2")
+        for g in self.gains:  # each candidate must be a valid step.gain (its check)
+            replace(self.step, gain=g)
         if self.gains and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 
