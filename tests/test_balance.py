@@ -108,3 +108,10 @@ def test_search_stays_where_the_model_has_data_and_never_steps_inwards():
         c = ctrl.decide(state + rng.normal(0, 0.05, len(STEP_STATE)), k)
         assert np.all(np.abs(c) <= limits + 1e-12)
         assert c[STEP_CHANNELS.index("dy")] >= 0.0
+
+
+def test_a_fall_before_the_first_step_records_no_steps():
+    from imitwalk.balance import STEP_CHANNELS, STEP_STATE
+
+    states, actions = StepController(StepConfig(), 100, 0.1).episode()
+    assert states.shape == (0, len(STEP_STATE)) and actions.shape == (0, len(STEP_CHANNELS) + 1)

@@ -18,15 +18,16 @@ from imitwalk.runs import RunDir
 def _strip(m: dict) -> dict:
     """A summary without its wall times (the one thing a rerun may change)."""
     out = {k: v for k, v in m.items() if k != "wall_seconds_for_learning"}
-    if out.get("gain_trials"):
-        out["gain_trials"] = {k: v for k, v in out["gain_trials"].items() if k != "wall_seconds"}
+    for key in ("gain_trials", "cadence_trials"):
+        if out.get(key):
+            out[key] = {k: v for k, v in out[key].items() if k != "wall_seconds"}
     return out
 
 
 @pytest.mark.parametrize("variant", ["faithful", "extended"])
 def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset(variant), [*TINY, "train_models=2"])
+    cfg = apply_overrides(preset(variant), [*TINY, "train_models=2", "cadences=1,1.12"])
     a = learn(ref, robot, cfg, tmp_path / "a")
     b = learn(ref, robot, cfg, tmp_path / "b")
     assert _strip(a) == _strip(b)
@@ -36,8 +37,12 @@ def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
         trials = a["gain_trials"]
         assert trials["seeds"] == list(trial_seeds(2)) and a["channel_gain"] == trials["gain"]
         assert [r["gain"] for r in trials["table"]] == list(cfg.gains)
+        cad = a["cadence_trials"]  # then the cadence, with the gain kept, on the same robots
+        assert cad["seeds"] == trials["seeds"] and a["cadence"] == cad["cadence"]
+        assert [r["cadence"] for r in cad["table"]] == list(cfg.cadences)
     else:
         assert a["gain_trials"] is None and a["channel_gain"] == 1.0
+        assert a["cadence_trials"] is None and a["cadence"] == 1.0
     la, lb = RunDir(tmp_path / "a").read_log(), RunDir(tmp_path / "b").read_log()
     strip = lambda log: [{k: v for k, v in e.items() if k != "wall_seconds"} for e in log]  # noqa: E731
     assert strip(la) == strip(lb)
@@ -69,20 +74,22 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
     assert all(s[0] == 0 for s in seeds) and seeds[0][1:] != seeds[1][1:]
 
 
-def test_a_run_interrupted_in_its_gain_trials_resumes_to_the_same_end(
-    tmp_path, robot, tiny_reference
+@pytest.mark.parametrize(("line", "key"), [("channel gain 0.5", "gain"), ("cadence 1:", "cadence")])
+def test_a_run_interrupted_in_its_trials_resumes_to_the_same_end(
+    tmp_path, robot, tiny_reference, line, key
 ):
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2", "schedule.stop=0.3"])
+    sets = [*TINY, "train_models=2", "schedule.stop=0.3", "cadences=1,1.12"]
+    cfg = apply_overrides(preset("extended"), sets)
     whole = learn(ref, robot, cfg, tmp_path / "whole")
 
-    def interrupt(line):
-        if line.startswith("channel gain 0.5"):
+    def interrupt(text):
+        if text.startswith(line):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
         learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
-    assert "gain" not in RunDir(tmp_path / "cut").read_json("checkpoint.json")
+    assert key not in RunDir(tmp_path / "cut").read_json("checkpoint.json")
     resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
     assert _strip(resumed) == _strip(whole)
 
@@ -180,6 +187,16 @@ def test_cli_learn_and_evaluate(tmp_path, capsys, tiny_reference):
 
     kept = RunDir(out).read_json("metrics.json")["channel_gain"]
     assert kept in (0.0, 0.5, 1.0) and load_gait(out).config.step.gain == kept
+    # so is the cadence: the learned controller plays the loop at it, open loop as retargeted
+    rd = RunDir(out)
+    rd.write_json("metrics.json", {**rd.read_json("metrics.json"), "cadence": 1.12})
+    lg = load_gait(out)
+    n = lg.ref.loops.shape[1]
+    assert lg.gait.n_ticks == round(n / 1.12) < n and lg.gait.ref.period < lg.ref.period
+    assert main([*argv, "--seeds", "1"]) == 0
+    fast = json.loads(capsys.readouterr().out)
+    assert fast["learned"]["cycle_period_s"] == pytest.approx(lg.gait.ref.period)
+    assert fast["open_loop"]["cycle_period_s"] == pytest.approx(lg.ref.period)
     # judged at another scale: its own file, the scale recorded
     argv += ["--scale", "0.3"]
     assert main(argv) == 0

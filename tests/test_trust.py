@@ -95,3 +95,18 @@ def test_gain_settings_from_the_command_line():
     assert apply_overrides(preset("extended"), ["gains=0.5,1"]).gains == (0.5, 1.0)
     with pytest.raises(ConfigError, match="0 <= gain <= 2"):
         apply_overrides(preset("extended"), ["gains=0,3"])
+
+
+def test_the_same_trials_pick_a_cadence_under_its_own_name():
+    def runs(rate, seeds):  # the faster cadence keeps every robot up
+        return [
+            {"fell": rate < 1.1, "fall_time_s": 5.0, "seconds": 5.0, "yaw_drift_deg": 1.0}
+            if rate < 1.1
+            else {"fell": False, "fall_time_s": None, "seconds": SECONDS, "yaw_drift_deg": 1.0}
+            for _ in seeds
+        ]
+
+    choice = tune_gain(runs, (1.0, 1.12), (0, 1), key="cadence")
+    d = choice.to_dict()
+    assert d["cadence"] == 1.12 and "gain" not in d
+    assert [r["cadence"] for r in d["table"]] == [1.0, 1.12]

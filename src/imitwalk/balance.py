@@ -215,9 +215,11 @@ class StepController:
 
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:
-        """The recorded steps for training: states ``(K, 7)`` and actions ``(K, 5)``
-        (channels and the scale)."""
+        """The recorded steps for training: states ``(K, 8)`` and actions ``(K, 6)``
+        (channels and the scale); K may be 0."""
         k = min(len(self.states), len(self.actions))
+        if k == 0:  # the robot fell before its first step decision
+            return np.zeros((0, len(STEP_STATE))), np.zeros((0, len(STEP_CHANNELS) + 1))
         acts = np.c_[np.asarray(self.actions[:k]).reshape(k, -1), np.full(k, self.scale)]
         return np.asarray(self.states[:k]).reshape(k, -1), acts
 

@@ -186,6 +186,8 @@ def learn(args: argparse.Namespace) -> int:
         "wall_seconds_for_learning",
         "channel_gain",
         "gain_trials",
+        "cadence",
+        "cadence_trials",
     )
     out = {k: summary[k] for k in keys}
     out["run_dir"] = str(rd.path)

@@ -19,6 +19,7 @@ from imitwalk.metrics import summarise, walk_metrics
 from imitwalk.models import build_policy, fit_models, unstack_episodes
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed
+from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
@@ -46,7 +47,10 @@ class LearnedGait:
         config = replace(config, step=replace(config.step, gain=float(gain)))
         self.ref, self.config, self.metrics = ref, config, metrics
         self.scale = float(metrics["scale_reached"]) or config.schedule.start
-        self.gait = GaitModel(ref, config.schedule.scales(), config.gait)
+        self.cadence = float(metrics.get("cadence", 1.0))  # picked by the cadence trials
+        # the learned controller plays the loop at its cadence; open loop, as retargeted
+        played = with_cadence(ref, self.cadence)
+        self.gait = GaitModel(played, config.schedule.scales(), config.gait)
         self.models = fit_models(data, config)
 
     def policy(self, robot: Robot, scale: float | None = None):
@@ -71,23 +75,25 @@ _CACHE: dict = {}
 
 def _one(job) -> dict:
     run_dir, robot, mode, seed, seconds, base, scale = job
-    key = str(run_dir)
+    # a worker keeps the last run it loaded, until that run's metrics.json changes
+    key = (str(run_dir), RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
         _CACHE[key] = load_gait(run_dir)
     lg = _CACHE[key]
     scale = lg.scale if scale is None else scale
     opts = perturbed(seed, base, disturbance=seed != 0)
-    steps = round(seconds / lg.ref.dt)
-    q_ref = lg.ref.trajectory(scale, seconds)
+    ref = lg.gait.ref if mode == "learned" else lg.ref  # at the cadence each one plays
+    steps = round(seconds / ref.dt)
+    q_ref = ref.trajectory(scale, seconds)
     if mode == "learned":
         ro = run(MujocoPlant(robot, opts), lg.policy(robot, scale), steps)
     else:
         ro = playback(MujocoPlant(robot, opts), q_ref, q0=q_ref[0])
-    m = walk_metrics(ro, lg.ref.expected_distance(scale, ro.seconds), q_ref)
+    m = walk_metrics(ro, ref.expected_distance(scale, ro.seconds), q_ref)
     out = m.to_dict()
     out["seed"] = seed
-    out["cycle_period_s"] = lg.ref.period
+    out["cycle_period_s"] = ref.period
     return out
 
 

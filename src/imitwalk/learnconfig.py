@@ -8,7 +8,8 @@ posture outside the subspace added back (so the nominal action is the reference)
 balance channels with their own step model and search (:mod:`imitwalk.balance`), a
 bootstrap ensemble of step models that the search must all convince
 (:mod:`imitwalk.ensemble`), training on perturbed robots as well as the nominal one, and
-the channel gain picked by measured trials (:mod:`imitwalk.trust`).
+the channel gain picked by measured trials (:mod:`imitwalk.trust`); the cadence can be
+picked the same way (``cadences``, off: on our clips it kept the human's).
 """
 
 from __future__ import annotations
@@ -96,6 +97,10 @@ class LearnConfig:
         gains: candidate channel gains tried once the schedule has ended, each on the
             same ``gain_robots`` robots for ``gain_seconds``; the one that measures best
             is kept (:mod:`imitwalk.trust`). Empty: keep ``step.gain``.
+        cadences: candidate cadence rates (the loop played that many times as fast,
+            :func:`imitwalk.retarget.cadence.with_cadence`) tried after the gains, with
+            the gain kept, on the same robots; list the human's own rate, 1, first.
+            Empty: the reference's cadence.
         seed: random seed; workers: parallel processes (``None``: one per core).
     """
 
@@ -108,6 +113,7 @@ class LearnConfig:
     train_models: int = 3
     fresh_robots: bool = False
     gains: tuple[float, ...] = ()
+    cadences: tuple[float, ...] = ()
     gain_robots: int = 12
     gain_seconds: float = 24.0
     seed: int = 0
@@ -116,7 +122,10 @@ class LearnConfig:
     def __post_init__(self):
         for g in self.gains:  # each candidate must be a valid step.gain (its check)
             replace(self.step, gain=g)
-        if self.gains and self.gain_robots < 1:
+        for r in self.cadences:
+            if not 0.5 <= r <= 2.0:
+                raise ConfigError(f"cadences: {r} is not a rate in 0.5..2")
+        if (self.gains or self.cadences) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 
 

@@ -8,8 +8,9 @@ scale schedule: a scale is passed when its last ``confirm`` iterations (no explo
 walk without a fall on every training robot. When the schedule stops, a few
 consolidation iterations at the scale reached add on-policy data where the gait will be
 used (their falls are logged; they do not change the scale reached). With ``gains``, the
-channel-gain trials then decide how much of the learned correction to apply
-(:mod:`imitwalk.trust`); they are checkpointed too. After every
+channel-gain trials then decide how much of the learned correction to apply, and with
+``cadences`` the cadence trials how fast to play the loop (:mod:`imitwalk.trust`); they
+are checkpointed too. After every
 iteration the run folder is checkpointed atomically, so ``resume`` continues an
 interrupted run and ends where an uninterrupted one would (same seed, same result).
 """
@@ -29,6 +30,7 @@ from imitwalk.learnconfig import LearnConfig
 from imitwalk.models import build_policy, fit_models, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import train_seeds, trial_seeds
+from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
@@ -203,12 +205,14 @@ def learn(
         rd.write_json("checkpoint.json", state)
         if progress:
             progress(_progress_line(entry))
-    if config.gains and config.steps and state["passed"] and "gain" not in state:
-        choice = _tune(gait, robot, config, data, max(state["passed"]), progress)
-        state["gain"] = choice.to_dict()
-        state["sim_seconds"] += choice.sim_seconds
-        state["wall_seconds"] += choice.wall_seconds
-        rd.write_json("checkpoint.json", state)
+    for key, values in (("gain", config.gains), ("cadence", config.cadences)):
+        if values and config.steps and state["passed"] and key not in state:
+            gain = state["gain"]["gain"] if "gain" in state else config.step.gain
+            choice = _tune(ref, robot, config, data, max(state["passed"]), key, gain, progress)
+            state[key] = choice.to_dict()
+            state["sim_seconds"] += choice.sim_seconds
+            state["wall_seconds"] += choice.wall_seconds
+            rd.write_json("checkpoint.json", state)
     summary = {
         "variant": config.variant,
         "scale_reached": max(state["passed"]) if state["passed"] else 0.0,
@@ -218,6 +222,8 @@ def learn(
         "wall_seconds_for_learning": state["wall_seconds"],
         "channel_gain": state["gain"]["gain"] if "gain" in state else config.step.gain,
         "gain_trials": state.get("gain"),
+        "cadence": state["cadence"]["cadence"] if "cadence" in state else 1.0,
+        "cadence_trials": state.get("cadence"),
         "gait": gait.report(),
         "config": asdict(config),
     }
@@ -225,22 +231,27 @@ def learn(
     return summary
 
 
-def _tune(gait, robot, config: LearnConfig, data, scale: float, progress):
-    """The channel-gain trials at the scale reached (:func:`imitwalk.trust.tune_gain`)."""
+def _tune(ref, robot, config: LearnConfig, data, scale, key, gain, progress):
+    """Trials at the scale reached (:func:`imitwalk.trust.tune_gain`) of the channel gain
+    (``key="gain"``), or of the cadence with the channel gain ``gain`` (``"cadence"``)."""
     t0 = time.perf_counter()
     models = fit_models(data, config)
+    values = config.gains if key == "gain" else config.cadences
 
-    def episodes(gain: float, seeds) -> list[dict]:
-        cfg = replace(config, step=replace(config.step, gain=gain))
+    def episodes(value: float, seeds) -> list[dict]:
+        g = value if key == "gain" else gain
+        rate = value if key == "cadence" else 1.0
+        cfg = replace(config, step=replace(config.step, gain=g))
+        gait = GaitModel(with_cadence(ref, rate), config.schedule.scales(), config.gait)
         jobs = [
             (robot, gait, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
             for j, s in enumerate(seeds)
         ]
         return [r["metrics"] for r in run_parallel(_episode, jobs, config.workers)]
 
-    choice = tune_gain(episodes, config.gains, trial_seeds(config.gain_robots), progress)
+    choice = tune_gain(episodes, values, trial_seeds(config.gain_robots), progress, key)
     if progress:
-        progress(f"channel gain kept: {choice.gain:g}")
+        progress(f"{'channel gain' if key == 'gain' else key} kept: {choice.gain:g}")
     return replace(choice, wall_seconds=time.perf_counter() - t0)
 
 

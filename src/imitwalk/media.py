@@ -66,13 +66,17 @@ def outcome(ro: Rollout) -> str:
 
 
 def gain(metrics: dict) -> str:
-    """The channel gain of a run's ``metrics.json``, and its trials if any ran, in a phrase."""
-    out = f"channel gain {metrics.get('channel_gain', 1.0):g}"
-    trials = metrics.get("gain_trials")
-    if not trials:
-        return out
-    rows = ", ".join(f"{r['gain']:g}: {r['falls']} fell" for r in trials["table"])
-    return f"{out} (trials on {len(trials['seeds'])} robots: {rows})"
+    """The channel gain and cadence of a run's ``metrics.json``, and their trials if any
+    ran, in a phrase."""
+    parts = []
+    for key, label in (("gain", "channel gain"), ("cadence", "cadence")):
+        value = metrics.get("channel_gain" if key == "gain" else key, 1.0)
+        out, trials = f"{label} {value:g}", metrics.get(f"{key}_trials")
+        if trials:
+            rows = ", ".join(f"{r[key]:g}: {r['falls']} fell" for r in trials["table"])
+            out += f" (trials on {len(trials['seeds'])} robots: {rows})"
+        parts.append(out)
+    return "; ".join(parts)
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:

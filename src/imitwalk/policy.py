@@ -56,6 +56,11 @@ class WalkPolicy:
         self.explore, self.rng = np.asarray(explore, dtype=float), rng
         self.start, self.loop, _ = gait.ref.at_scale(scale)
         self.n = gait.n_ticks
+        m = len(self.start)
+        # the balance channels' step clock: from the start-up's first step when the start-up
+        # steps at the loop's cadence, else (a reference at another cadence) from the loop
+        same = float(gait.ref.settings.get("cadence", 1.0)) == 1.0
+        self._clock0 = m % self.n + self.n if same else m
         self.estimator = StateEstimator(gait.ref.dt)
         nom = gait.nominal[gait._key(scale)]
         self._phi_table = nom[:, 0]
@@ -96,8 +101,8 @@ class WalkPolicy:
             if i < 0:  # cross-fade from the start-up into the controller over one cycle
                 w = (i + n) / n
                 q = (1.0 - w) * self.start[k] + w * q
-        if self.steps is not None and k >= m % n + n:  # channels act once the feet step
-            offsets = self._channels(k - (m % n + n), est)
+        if self.steps is not None and k >= self._clock0:  # channels act once the feet step
+            offsets = self._channels(k - self._clock0, est)
             if np.any(offsets):
                 q = q + self.channel_ik(k, offsets) - self._reference(k)
             else:

@@ -141,7 +141,7 @@ def write_report(
             media.robot_strip(renderer, ro, lg.ref.period, s.strip_frames) for _, ro in rp.runs
         ]
         ticks = plots.example_ticks(lg.gait.n_ticks, s.strip_frames)
-        loop = lg.ref.at_scale(rp.scale)[1]  # (N, n)
+        loop = lg.gait.ref.at_scale(rp.scale)[1]  # (N, n), at the learned cadence
         poses = [renderer.frame(media.pose_qpos(robot, loop[k])) for k in ticks]
     finally:
         renderer.close()

@@ -8,7 +8,9 @@ gain (the searched channel values × gain; 0 is the reference alone) on the same
 — ones it never learned on (:func:`imitwalk.perturb.trial_seeds`) — and keeps the gain
 that measures best: fewest falls, then the longest time up, then the least heading
 drift. This is the paper's execute-and-measure loop applied to one policy parameter;
-nothing here predicts, it only counts (pure NumPy).
+nothing here predicts, it only counts (pure NumPy). The same trials then pick the
+cadence (:func:`imitwalk.retarget.cadence.with_cadence`; ``key="cadence"``): how fast
+the loop is played, the step-timing handle of eq. (9), with the gain kept.
 """
 
 from __future__ import annotations
@@ -26,10 +28,12 @@ class GainChoice:
     """The outcome of the trials.
 
     Attributes:
-        gain: the gain kept; seeds: the trial robots (the same for every gain).
-        table: one row per candidate: ``gain``, ``falls``, ``mean_time_up_s`` (a fall
+        gain: the value kept (of the parameter ``key``); seeds: the trial robots (the
+            same for every candidate).
+        table: one row per candidate: ``key``, ``falls``, ``mean_time_up_s`` (a fall
             counts its fall time), ``mean_abs_yaw_deg``.
         sim_seconds: simulated time the trials used [s]; wall_seconds: their wall time.
+        key: the parameter tried: ``"gain"`` (the channel gain) or ``"cadence"``.
     """
 
     gain: float
@@ -37,10 +41,11 @@ class GainChoice:
     table: list[dict] = field(default_factory=list)
     sim_seconds: float = 0.0
     wall_seconds: float = 0.0
+    key: str = "gain"
 
     def to_dict(self) -> dict:
         return {
-            "gain": self.gain,
+            self.key: self.gain,
             "seeds": list(self.seeds),
             "table": self.table,
             "sim_seconds": self.sim_seconds,
@@ -48,17 +53,19 @@ class GainChoice:
         }
 
 
-def _row(gain: float, runs: Sequence[dict]) -> dict:
+def _row(gain: float, runs: Sequence[dict], key: str = "gain") -> dict:
     up = [r["fall_time_s"] if r["fell"] else r["seconds"] for r in runs]
     return {
-        "gain": float(gain),
+        key: float(gain),
         "falls": int(sum(bool(r["fell"]) for r in runs)),
         "mean_time_up_s": float(np.mean(up)),
         "mean_abs_yaw_deg": float(np.mean([abs(r["yaw_drift_deg"]) for r in runs])),
     }
 
 
-def select_gain(gains: Sequence[float], trials: Sequence[Sequence[dict]]) -> tuple[int, list]:
+def select_gain(
+    gains: Sequence[float], trials: Sequence[Sequence[dict]], key: str = "gain"
+) -> tuple[int, list]:
     """Index of the best gain and the table of all.
 
     Args:
@@ -67,10 +74,11 @@ def select_gain(gains: Sequence[float], trials: Sequence[Sequence[dict]]) -> tup
         trials: per gain, the episode metrics (``fell``, ``fall_time_s``, ``seconds``,
             ``yaw_drift_deg``: :class:`imitwalk.metrics.WalkMetrics` as a dict) on the
             same robots in the same order.
+        key: the parameter's name in the table.
     """
     if not gains or len(gains) != len(trials):
         raise ValueError("select_gain: one list of trials per candidate gain")
-    table = [_row(g, t) for g, t in zip(gains, trials, strict=True)]
+    table = [_row(g, t, key) for g, t in zip(gains, trials, strict=True)]
     keys = [(r["falls"], -r["mean_time_up_s"], r["mean_abs_yaw_deg"]) for r in table]
     return min(range(len(keys)), key=keys.__getitem__), table
 
@@ -80,18 +88,20 @@ def tune_gain(
     gains: Sequence[float],
     seeds: tuple[int, ...],
     progress=None,
+    key: str = "gain",
 ) -> GainChoice:
-    """Run ``run_episodes(gain, seeds) -> [metrics dict]`` for every candidate and keep
-    the best (:func:`select_gain`)."""
+    """Run ``run_episodes(value, seeds) -> [metrics dict]`` for every candidate value of
+    the parameter ``key`` and keep the best (:func:`select_gain`)."""
+    label = "channel gain" if key == "gain" else key
     trials = []
     for g in gains:
         trials.append(run_episodes(g, seeds))
         if progress:
             row = _row(g, trials[-1])
             progress(
-                f"channel gain {g:g}: fell {row['falls']}/{len(seeds)}, "
+                f"{label} {g:g}: fell {row['falls']}/{len(seeds)}, "
                 f"time up {row['mean_time_up_s']:.1f} s, |yaw| {row['mean_abs_yaw_deg']:.1f} deg"
             )
-    best, table = select_gain(gains, trials)
+    best, table = select_gain(gains, trials, key)
     sim = float(sum(r["seconds"] for t in trials for r in t))
-    return GainChoice(float(gains[best]), tuple(seeds), table, sim)
+    return GainChoice(float(gains[best]), tuple(seeds), table, sim, key=key)

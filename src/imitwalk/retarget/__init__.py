@@ -15,6 +15,7 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.mocap.motion import Motion
+from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
@@ -48,6 +49,9 @@ class RetargetConfig:
         search: run the parameter search (else ``params`` is used as is).
         params: reference parameters (the search's starting point).
         search_config: the search's budget.
+        cadence: play the loop this many times as fast as the human walked
+            (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
+            the human's cadence). 1: the human's own.
     """
 
     CHOICES: ClassVar[dict] = {"mapping": MAPPINGS}
@@ -58,6 +62,7 @@ class RetargetConfig:
     search: bool = True
     params: GaitParams = field(default_factory=GaitParams)
     search_config: SearchConfig = field(default_factory=SearchConfig)
+    cadence: float = 1.0
 
 
 @dataclass
@@ -85,6 +90,7 @@ class RetargetResult:
             "human_speed_mps": self.template.speed,
             "mapping": ref.mapping,
             "reference_frames": int(ref.loops.shape[1]),
+            "cadence": float(ref.settings.get("cadence", 1.0)),
             "reference_hz": 1.0 / ref.dt,
             "ik_residual_mm_mean": float(ref.residual_mm.mean()),
             "ik_residual_mm_max": float(ref.residual_mm.max()),
@@ -145,4 +151,5 @@ def retarget(
         "motion_fps": motion.fps,
         "filled": list(motion.filled),
     }
+    ref = with_cadence(ref, cfg.cadence)
     return RetargetResult(ref, motion.n_frames, motion.fps, template, frames, seconds)
