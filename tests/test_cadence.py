@@ -85,3 +85,20 @@ def test_rates_compound_relative_to_the_human(tiny_reference):
     twice = with_cadence(with_cadence(ref, 1.12), 1.12)
     n, n3 = ref.loops.shape[1], twice.loops.shape[1]
     assert twice.settings["cadence"] == pytest.approx(n / n3)
+
+
+def test_the_step_clock_starts_at_the_loop_when_the_start_up_keeps_the_human_cadence(
+    tiny_reference,
+):
+    from imitwalk.balance import StepConfig, StepController
+    from imitwalk.gait import GaitModel
+    from imitwalk.policy import WalkPolicy
+
+    ref, _ = tiny_reference
+    for rate in (1.0, 1.12):
+        gait = GaitModel(with_cadence(ref, rate), (0.3, 0.4), preset("extended").gait)
+        n = gait.n_ticks
+        policy = WalkPolicy(gait, 0.4, steps=StepController(StepConfig(), n, 0.1))
+        m = len(policy.start)
+        # the human cadence: from the start-up's first step (it is whole loops long)
+        assert policy._clock0 == (m % n + n if rate == 1.0 else m)
