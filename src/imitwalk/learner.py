@@ -208,7 +208,7 @@ def learn(
     for key, values in (("gain", config.gains), ("cadence", config.cadences)):
         if values and config.steps and state["passed"] and key not in state:
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain
-            choice = _tune(ref, robot, config, data, max(state["passed"]), key, gain, progress)
+            choice = _tune(gait, robot, config, data, max(state["passed"]), key, gain, progress)
             state[key] = choice.to_dict()
             state["sim_seconds"] += choice.sim_seconds
             state["wall_seconds"] += choice.wall_seconds
@@ -231,7 +231,7 @@ def learn(
     return summary
 
 
-def _tune(ref, robot, config: LearnConfig, data, scale, key, gain, progress):
+def _tune(gait, robot, config: LearnConfig, data, scale, key, gain, progress):
     """Trials at the scale reached (:func:`imitwalk.trust.tune_gain`) of the channel gain
     (``key="gain"``), or of the cadence with the channel gain ``gain`` (``"cadence"``)."""
     t0 = time.perf_counter()
@@ -242,9 +242,11 @@ def _tune(ref, robot, config: LearnConfig, data, scale, key, gain, progress):
         g = value if key == "gain" else gain
         rate = value if key == "cadence" else 1.0
         cfg = replace(config, step=replace(config.step, gain=g))
-        gait = GaitModel(with_cadence(ref, rate), config.schedule.scales(), config.gait)
+        walk = gait  # the gait the schedule learned, at the candidate cadence
+        if rate != 1.0:
+            walk = GaitModel(with_cadence(gait.ref, rate), gait.scales, config.gait)
         jobs = [
-            (robot, gait, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
+            (robot, walk, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
             for j, s in enumerate(seeds)
         ]
         return [r["metrics"] for r in run_parallel(_episode, jobs, config.workers)]
