@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from scipy.interpolate import make_interp_spline
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
@@ -28,12 +29,10 @@ _ADVANCING = ("l_sole", "r_sole", "com")
 
 def _resample(a: np.ndarray, u: np.ndarray, after: np.ndarray) -> np.ndarray:
     """``a`` ``(S, N, ...)`` at fractional ticks ``u`` ``(N2,)`` in [0, N), linearly;
-    ``after`` ``(S, ...)`` is the value at tick N (the loop's first tick a stride ahead,
-    or the loop's first tick after the start-up)."""
+    ``after`` ``(S, ...)`` is the value at tick N (the loop's first tick, or it a stride
+    ahead for what moves forward)."""
     ext = np.concatenate([a, after[:, None]], axis=1)
-    i0 = np.floor(u).astype(int)
-    w = (u - i0).reshape((1, -1) + (1,) * (a.ndim - 2))
-    return (1.0 - w) * ext[:, i0] + w * ext[:, i0 + 1]
+    return make_interp_spline(np.arange(ext.shape[1]), ext, k=1, axis=1)(u)
 
 
 def with_cadence(ref: Reference, rate: float) -> Reference:
