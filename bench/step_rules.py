@@ -69,7 +69,7 @@ def _one(job) -> dict:
     if name == "open":
         ro = playback(plant, q, q0=q[0])
     else:
-        gait = GaitModel(ref, lg.config.schedule.scales(), lg.config.gait)
+        gait = GaitModel(ref, lg.gait.scales, lg.config.gait) if rate else lg.gait
         policy = build_policy(gait, lg.scale, lg.config, lg.models, robot=robot)
         if name != "model":
             terms = [(c, s, float(k)) for c, s, k in (t.split(":") for t in name.split(";"))]
