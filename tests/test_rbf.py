@@ -55,6 +55,20 @@ def test_interpolates_its_centres_when_ridge_vanishes(seed, n, d, covariance):
     np.testing.assert_allclose(net.predict(A), B, atol=1e-8)
 
 
+@pytest.mark.filterwarnings("error")  # k-means warns when asked for more centres than points
+@pytest.mark.parametrize("covariance", COVARIANCES)
+def test_repeated_rows_make_one_centre_each(covariance):
+    # one robot replayed gives the same inputs again: fewer distinct rows than centres
+    A = separated_points(3, 10, 2)
+    B = np.column_stack([np.sin(A.sum(axis=1)), np.cos(A[:, 0])])
+    net = RBFNetwork(n_centers=24, ridge=1e-12, covariance=covariance).fit(
+        np.tile(A, (5, 1)), np.tile(B, (5, 1))
+    )
+    assert net.centers_.shape == (10, 2)
+    np.testing.assert_allclose(np.sort(net.centers_, axis=0), np.sort(A, axis=0), atol=1e-12)
+    np.testing.assert_allclose(net.predict(A), B, atol=1e-8)
+
+
 @pytest.mark.parametrize("covariance", COVARIANCES)
 def test_predict_is_eq4_with_the_public_parameters(covariance):
     rng = np.random.default_rng(1)
