@@ -72,6 +72,7 @@ def main() -> None:
         rows[name] = {
             "settings": sets,
             "scale_reached": summary["scale_reached"],
+            "channel_gain": summary.get("channel_gain"),
             "learn_wall_seconds": round(wall, 1),
             "at_scale_reached": _row(reached),
             f"at_{args.scale:g}": _row(fixed["learned"]),
