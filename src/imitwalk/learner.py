@@ -34,7 +34,7 @@ from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
-from imitwalk.trust import tune_gain
+from imitwalk.trust import LABELS, tune_gain
 
 __all__ = ["learn"]
 
@@ -253,7 +253,7 @@ def _tune(gait, robot, config: LearnConfig, data, scale, key, gain, progress):
 
     choice = tune_gain(episodes, values, trial_seeds(config.gain_robots), progress, key)
     if progress:
-        progress(f"{'channel gain' if key == 'gain' else key} kept: {choice.gain:g}")
+        progress(f"{LABELS[key]} kept: {choice.gain:g}")
     return replace(choice, wall_seconds=time.perf_counter() - t0)
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from imitwalk import plots
 from imitwalk.robots import Robot
 from imitwalk.sim import MujocoPlant, Rollout, SimOptions, playback, run
+from imitwalk.trust import LABELS
 
 __all__ = [
     "Replays",
@@ -69,7 +70,7 @@ def gain(metrics: dict) -> str:
     """The channel gain and cadence of a run's ``metrics.json``, and their trials if any
     ran, in a phrase."""
     parts = []
-    for key, label in (("gain", "channel gain"), ("cadence", "cadence")):
+    for key, label in LABELS.items():
         value = metrics.get("channel_gain" if key == "gain" else key, 1.0)
         out, trials = f"{label} {value:g}", metrics.get(f"{key}_trials")
         if trials:

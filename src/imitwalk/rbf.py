@@ -123,12 +123,12 @@ class RBFNetwork(RegressorMixin, BaseEstimator):
         scale = A.std(axis=0)
         scale = np.where(scale > 1e-12 * (1.0 + np.abs(mean)), scale, 1.0)
         Z = (A - mean) / scale  # (N, d) standardised
-        distinct = np.unique(Z, axis=0) if N > self.n_centers else Z
+        distinct, inverse = np.unique(Z, axis=0, return_inverse=True)
         if N <= self.n_centers:
             C, labels = Z.copy(), np.arange(N)
         elif len(distinct) <= self.n_centers:  # repeated rows (e.g. one robot, replayed)
             C = distinct  # every distinct input a centre; k-means would warn and duplicate
-            labels = np.argmin(np.sum((Z[:, None, :] - C[None, :, :]) ** 2, axis=-1), axis=1)
+            labels = inverse.reshape(-1)
         else:
             km = KMeans(n_clusters=int(self.n_centers), n_init=3, random_state=self.random_state)
             km.fit(Z)

@@ -20,7 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["GainChoice", "select_gain", "tune_gain"]
+__all__ = ["LABELS", "GainChoice", "select_gain", "tune_gain"]
+
+#: What the trials tune, by ``key``, in words (progress lines, the report).
+LABELS = {"gain": "channel gain", "cadence": "cadence"}
 
 
 @dataclass(frozen=True)
@@ -92,7 +95,7 @@ def tune_gain(
 ) -> GainChoice:
     """Run ``run_episodes(value, seeds) -> [metrics dict]`` for every candidate value of
     the parameter ``key`` and keep the best (:func:`select_gain`)."""
-    label = "channel gain" if key == "gain" else key
+    label = LABELS[key]
     trials = []
     for g in gains:
         trials.append(run_episodes(g, seeds))
