@@ -31,7 +31,13 @@ def _controller(actions, n=100, ds=0.1):
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.lists(st.lists(finite, min_size=5, max_size=5), min_size=4, max_size=4))
+@given(
+    st.lists(
+        st.lists(finite, min_size=len(STEP_CHANNELS), max_size=len(STEP_CHANNELS)),
+        min_size=4,
+        max_size=4,
+    )
+)
 def test_task_offsets_are_continuous_and_start_at_zero(raw):
     ctrl = _controller([np.array(c) * ctrl_max() for c in raw])
     offs = np.array([ctrl.offsets(i) for i in range(len(raw) * 50)])  # (T, 8)

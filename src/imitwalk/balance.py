@@ -13,7 +13,11 @@ Channels (mirrored so that one model serves left and right steps):
 * ``yaw``: the swing foot lands turned [rad] (the body follows it during the next stance);
 * ``sway``: an extra lateral shift of the centre of mass towards the stance foot [m];
 * ``lean``: the centre of mass further forward over the feet [m], held from step to step
-  (it moves linearly from the previous step's value to this step's over the step).
+  (it moves linearly from the previous step's value to this step's over the step);
+* ``time``: the step takes longer (> 0) or shorter (< 0) by this fraction of its nominal
+  duration: the whole task-space plan, swing, sway and all, is played slower or faster
+  over that step (:class:`imitwalk.policy.WalkPolicy` keeps the plan's clock). Off by
+  default (``step.channels`` names the channels in use).
 
 They act in task space: the landing offsets grow smoothly over the swing and decay over
 the foot's next stance, the sway is a half-sine bump over the step; the robot's IK
@@ -32,7 +36,7 @@ import numpy as np
 
 from imitwalk.controller import stability_cost
 from imitwalk.ensemble import ModelEnsemble
-from imitwalk.errors import ConfigError
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.predictor import SensoryMotorModel
 
 __all__ = [
@@ -44,7 +48,10 @@ __all__ = [
     "step_target",
 ]
 
-STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean")
+STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
+#: The channels of the first releases: their search candidates and exploration noise are
+#: always drawn (zero when off), so that runs written before ``time`` replay exactly.
+_ALWAYS_DRAWN = 5
 #: Step state, in the stance side's mirrored frame.
 STEP_STATE = (
     "roll",
@@ -64,8 +71,10 @@ class StepConfig:
     """Step-level channel learning.
 
     Attributes:
-        channels: which of :data:`STEP_CHANNELS` the learner may use.
-        c_max: box half-width per channel in :data:`STEP_CHANNELS` order [m, m, rad, m, m].
+        channels: which of :data:`STEP_CHANNELS` the learner may use (default: all but
+            ``time``).
+        c_max: box half-width per channel in :data:`STEP_CHANNELS` order
+            [m, m, rad, m, m, fraction of the step's duration].
             ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
             apart, and a narrower step lands one foot on the other.
         weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
@@ -88,8 +97,8 @@ class StepConfig:
             off). The learner can pick it from measured trials (``LearnConfig.gains``).
     """
 
-    channels: tuple[str, ...] = STEP_CHANNELS
-    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01)
+    channels: tuple[str, ...] = STEP_CHANNELS[:_ALWAYS_DRAWN]
+    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15)
     weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
     effort: float = 0.05
     horizon: int = 2
@@ -102,6 +111,18 @@ class StepConfig:
     gain: float = 1.0
 
     def __post_init__(self):
+        for c in self.channels:
+            if c not in STEP_CHANNELS:
+                raise unknown_name("step channel", c, STEP_CHANNELS, ConfigError)
+        if len(self.c_max) == _ALWAYS_DRAWN:  # a run written before the time channel
+            object.__setattr__(self, "c_max", (*self.c_max, 0.0))
+        if len(self.c_max) != len(STEP_CHANNELS):
+            raise ConfigError(
+                f"step.c_max has {len(self.c_max)} values: expected one per channel of "
+                f"{', '.join(STEP_CHANNELS)}"
+            )
+        if "time" in self.channels and not 0.0 <= self.c_max[-1] < 0.5:
+            raise ConfigError(f"step.c_max for time={self.c_max[-1]}: expected 0 <= c < 0.5")
         if not 0.0 <= self.margin < 1.0:
             raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
         if not 0.0 <= self.gain <= 2.0:
@@ -169,6 +190,7 @@ class StepController:
         self.c_min = -self.c_max * (np.array(STEP_CHANNELS) != "dy")  # dy: outwards only
         # the search stays where the model has seen data; exploration may go to the limits
         self.box = self.c_max if limits is None else np.minimum(self.c_max, limits)
+        self._drawn = (np.arange(len(STEP_CHANNELS)) < _ALWAYS_DRAWN) | (self.mask > 0)
         self.states: list[np.ndarray] = []  # mirrored step states s_k
         self.actions: list[np.ndarray] = []  # channel values c_k (mirrored coordinates)
         self.predicted: list[float] = []
@@ -187,7 +209,9 @@ class StepController:
             c = self.config.gain * c
             self.predicted.append(pred)
         if self.rng is not None and self.explore > 0:
-            c = c + self.explore * self.c_max * self.rng.uniform(-1.0, 1.0, len(c))
+            noise = np.zeros(len(c))
+            noise[self._drawn] = self.rng.uniform(-1.0, 1.0, int(self._drawn.sum()))
+            c = c + self.explore * self.c_max * noise
         c = np.clip(c, self.c_min, self.c_max)
         self.actions.append(c)
         return c
@@ -196,8 +220,10 @@ class StepController:
         cfg = self.config
         rng = np.random.default_rng(len(self.states))
         lo = np.maximum(-self.box, self.c_min)
-        cand = rng.uniform(lo, self.box, (cfg.candidates, len(STEP_CHANNELS)))
-        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, 5)
+        cand = np.zeros((cfg.candidates, len(STEP_CHANNELS)))
+        d = self._drawn
+        cand[:, d] = rng.uniform(lo[d], self.box[d], (cfg.candidates, int(d.sum())))
+        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, channels)
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand
         seq[:, :, -1] = self.scale  # the model also sees the stride scale
@@ -213,10 +239,17 @@ class StepController:
             best = 0
         return cand[best], float(cost[:, best].mean())
 
+    def rate(self, k: int) -> float:
+        """How fast step ``k`` plays the plan: 1 / (1 + ``time``) loop ticks per control
+        tick (1 before the step is decided)."""
+        if k >= len(self.actions):
+            return 1.0
+        return 1.0 / (1.0 + float(self.actions[k][-1]))
+
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:
-        """The recorded steps for training: states ``(K, 8)`` and actions ``(K, 6)``
-        (channels and the scale); K may be 0."""
+        """The recorded steps for training: states ``(K, 8)`` and actions
+        ``(K, len(STEP_CHANNELS) + 1)`` (channels and the scale); K may be 0."""
         k = min(len(self.states), len(self.actions))
         if k == 0:  # the robot fell before its first step decision
             return np.zeros((0, len(STEP_STATE))), np.zeros((0, len(STEP_CHANNELS) + 1))

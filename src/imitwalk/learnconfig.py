@@ -125,6 +125,11 @@ class LearnConfig:
         for r in self.cadences:
             if not 0.5 <= r <= 2.0:
                 raise ConfigError(f"cadences: {r} is not a rate in 0.5..2")
+        if self.steps and "time" in self.step.channels and self.tick.enabled:
+            raise ConfigError(
+                "step channel 'time' needs tick.enabled=false: the per-tick search acts "
+                "on the plan's ticks, which the time channel stretches"
+            )
         if (self.gains or self.cadences) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 

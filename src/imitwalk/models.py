@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imitwalk.balance import StepController, step_target
+from imitwalk.balance import STEP_CHANNELS, StepController, step_target
 from imitwalk.controller import ActionSelector
 from imitwalk.ensemble import ModelEnsemble
 from imitwalk.errors import RunError
@@ -176,6 +176,10 @@ def unstack_episodes(arrays: dict[str, np.ndarray]) -> dict:
         if f"{kind}_len" not in arrays:
             continue
         cut = np.cumsum(arrays[f"{kind}_len"])[:-1]
+        if kind == "step" and arrays["step_A"].shape[1] == len(STEP_CHANNELS):
+            # written before the time channel: it was 0 (nominal) throughout
+            A = arrays["step_A"]
+            arrays = {**arrays, "step_A": np.c_[A[:, :-1], np.zeros(len(A)), A[:, -1:]]}
         data[kind] = list(
             zip(np.split(arrays[f"{kind}_S"], cut), np.split(arrays[f"{kind}_A"], cut), strict=True)
         )

@@ -10,7 +10,9 @@ on; the joint change it makes is added to the controller's output. Over the last
 start-up cycle the output is cross-faded from the start-up trajectory to the
 controller's, unless the gait adds its residual back (then the controller's nominal
 output is the reference, which continues the start-up exactly, and the start-up is
-played to its end). It records what the learner trains on.
+played to its end). Once the feet step, the plan runs on its own clock, which the
+``time`` channel slows or speeds over a step (between ticks, targets are interpolated
+linearly). It records what the learner trains on.
 """
 
 from __future__ import annotations
@@ -71,6 +73,7 @@ class WalkPolicy:
         self.tick_predicted: list[float] = []
         self._a_prev: np.ndarray | None = None
         self._step_k = 0
+        self._v: float | None = None  # the plan's clock once the feet step [ticks]
         self._gyro_sum, self._gyro_n = np.zeros(4), 0
 
     @property
@@ -92,21 +95,45 @@ class WalkPolicy:
 
     def __call__(self, k: int, obs) -> np.ndarray:
         est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
+        if self.steps is None or k < self._clock0:
+            return self._at(k, est)
+        # once the feet step, the plan runs on its own clock v: one loop tick per control
+        # tick, slower or faster over a step whose ``time`` channel is not 0
+        v = float(k) if self._v is None else self._v
+        q = self._base(v, est)
+        offsets = self._channels(v - self._clock0, est)
+        if np.any(offsets):
+            q = q + self.channel_ik(v, offsets) - self._base(v, None, reference=True)
+        else:
+            self.channel_ik(v, offsets)  # keep the solver's warm start on track
+        self._v = v + self.steps.rate(self._step_k - 1)
+        return q
+
+    def _at(self, k: int, est, record: bool = True) -> np.ndarray:
+        """The joint targets at plan tick ``k`` without the channels."""
         m, n = len(self.start), self.n
         if k < self.first_loop_tick:
-            q = self.start[k].copy()
-        else:
-            i = k - m  # loop tick; negative during the cross-fade cycle
-            q = self._tick(i, est)
-            if i < 0:  # cross-fade from the start-up into the controller over one cycle
-                w = (i + n) / n
-                q = (1.0 - w) * self.start[k] + w * q
-        if self.steps is not None and k >= self._clock0:  # channels act once the feet step
-            offsets = self._channels(k - self._clock0, est)
-            if np.any(offsets):
-                q = q + self.channel_ik(k, offsets) - self._reference(k)
-            else:
-                self.channel_ik(k, offsets)  # keep the solver's warm start on track
+            return self.start[k].copy()
+        i = k - m  # loop tick; negative during the cross-fade cycle
+        q = (
+            self._tick(i, est)
+            if record
+            else self.gait.joints(self.scale, self.gait.nominal_action(self.scale, i))
+        )
+        if i < 0:  # cross-fade from the start-up into the controller over one cycle
+            w = (i + n) / n
+            q = (1.0 - w) * self.start[k] + w * q
+        return q
+
+    def _base(self, v: float, est, reference: bool = False) -> np.ndarray:
+        """Joint targets at plan time ``v`` [ticks] (linear between ticks): the
+        controller's (``reference=False``, recording its tick) or the reference's."""
+        k0 = int(np.floor(v))
+        a = v - k0
+        q = self._reference(k0) if reference else self._at(k0, est)
+        if a > 0.0:
+            q1 = self._reference(k0 + 1) if reference else self._at(k0 + 1, None, record=False)
+            q = (1.0 - a) * q + a * q1
         return q
 
     def _reference(self, k: int) -> np.ndarray:
@@ -130,8 +157,9 @@ class WalkPolicy:
         self._a_prev = action
         return self.gait.joints(self.scale, action)
 
-    def _channels(self, j: int, est) -> np.ndarray:
-        """Step-level balance channels at stepping tick ``j`` (the clock; 0 = first step)."""
+    def _channels(self, j: float, est) -> np.ndarray:
+        """Step-level balance channels at stepping tick ``j`` (the plan's clock; 0 = first
+        step)."""
         self._gyro_sum += np.r_[est.gyro, est.cop_x]
         self._gyro_n += 1
         half = self.n / 2.0

@@ -37,7 +37,7 @@ class OnlineIK:
         self._fresh = True
         self.ik.start(robot.stand_qpos)
 
-    def _tick_plan(self, k: int) -> SimpleNamespace:
+    def _plan_row(self, k: int) -> dict:
         if k < self.n_total:
             i, shift = k, 0.0
         else:
@@ -45,17 +45,33 @@ class OnlineIK:
             i, shift = self.m + r, c * self.stride
         p = self.plan
         dx = np.array([shift, 0.0, 0.0])
+        return {
+            "l_sole": p["l_sole"][i] + dx,
+            "r_sole": p["r_sole"][i] + dx,
+            "com": p["com"][i] + dx[:2],
+            "pelvis_z": p["pelvis_z"][i],
+            "upper": p["upper"][i],
+        }
+
+    def _tick_plan(self, k: float) -> SimpleNamespace:
+        """The plan at tick ``k``, linear between ticks for a fractional ``k``."""
+        k0 = int(np.floor(k))
+        row = self._plan_row(k0)
+        a = k - k0
+        if a > 0.0:
+            nxt = self._plan_row(k0 + 1)
+            row = {key: (1.0 - a) * row[key] + a * nxt[key] for key in row}
         return SimpleNamespace(
-            l_sole=(p["l_sole"][i] + dx)[None],
-            r_sole=(p["r_sole"][i] + dx)[None],
-            com=(p["com"][i] + dx[:2])[None],
-            pelvis_z=p["pelvis_z"][i : i + 1],
-            upper={u: p["upper"][i : i + 1, j] for j, u in enumerate(UPPER)},
+            l_sole=row["l_sole"][None],
+            r_sole=row["r_sole"][None],
+            com=row["com"][None],
+            pelvis_z=np.atleast_1d(row["pelvis_z"]),
+            upper={u: row["upper"][j : j + 1] for j, u in enumerate(UPPER)},
         )
 
-    def __call__(self, k: int, offsets: np.ndarray) -> np.ndarray:
-        """Joint angles [rad] at tick ``k`` with ``offsets`` ``(8,)`` in
-        :data:`imitwalk.retarget.ik.CHANNELS` order."""
+    def __call__(self, k: float, offsets: np.ndarray) -> np.ndarray:
+        """Joint angles [rad] at tick ``k`` (fractional: between two ticks) with
+        ``offsets`` ``(8,)`` in :data:`imitwalk.retarget.ik.CHANNELS` order."""
         it = 30 if self._fresh else 10
         self._fresh = False
         return self.ik.solve_tick(self._tick_plan(k), 0, offsets, max_iter=it)
