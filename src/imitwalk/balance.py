@@ -52,6 +52,7 @@ STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
 #: The channels of the first releases: their search candidates and exploration noise are
 #: always drawn (zero when off), so that runs written before ``time`` replay exactly.
 _ALWAYS_DRAWN = 5
+_TIME = STEP_CHANNELS.index("time")
 #: Step state, in the stance side's mirrored frame.
 STEP_STATE = (
     "roll",
@@ -97,7 +98,7 @@ class StepConfig:
             off). The learner can pick it from measured trials (``LearnConfig.gains``).
     """
 
-    channels: tuple[str, ...] = STEP_CHANNELS[:_ALWAYS_DRAWN]
+    channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
     c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15)
     weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
     effort: float = 0.05
@@ -121,8 +122,8 @@ class StepConfig:
                 f"step.c_max has {len(self.c_max)} values: expected one per channel of "
                 f"{', '.join(STEP_CHANNELS)}"
             )
-        if "time" in self.channels and not 0.0 <= self.c_max[-1] < 0.5:
-            raise ConfigError(f"step.c_max for time={self.c_max[-1]}: expected 0 <= c < 0.5")
+        if "time" in self.channels and not 0.0 <= self.c_max[_TIME] < 0.5:
+            raise ConfigError(f"step.c_max for time={self.c_max[_TIME]}: expected 0 <= c < 0.5")
         if not 0.0 <= self.margin < 1.0:
             raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
         if not 0.0 <= self.gain <= 2.0:
@@ -244,7 +245,7 @@ class StepController:
         tick (1 before the step is decided)."""
         if k >= len(self.actions):
             return 1.0
-        return 1.0 / (1.0 + float(self.actions[k][-1]))
+        return 1.0 / (1.0 + float(self.actions[k][_TIME]))
 
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:
