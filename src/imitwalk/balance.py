@@ -46,6 +46,7 @@ __all__ = [
     "StepController",
     "mirror_state",
     "step_target",
+    "upgrade_step_actions",
 ]
 
 STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
@@ -116,7 +117,9 @@ class StepConfig:
             if c not in STEP_CHANNELS:
                 raise unknown_name("step channel", c, STEP_CHANNELS, ConfigError)
         if len(self.c_max) == _ALWAYS_DRAWN:  # a run written before the time channel
-            object.__setattr__(self, "c_max", (*self.c_max, 0.0))
+            c_max = list(self.c_max)
+            c_max.insert(_TIME, 0.0)
+            object.__setattr__(self, "c_max", tuple(c_max))
         if len(self.c_max) != len(STEP_CHANNELS):
             raise ConfigError(
                 f"step.c_max has {len(self.c_max)} values: expected one per channel of "
@@ -145,6 +148,15 @@ def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: floa
     out = (S[near] if near.any() else S).mean(axis=0)
     out[2] = 0.0
     return out
+
+
+def upgrade_step_actions(A: np.ndarray) -> np.ndarray:
+    """Recorded step actions ``(K, 6)`` of a run written before the ``time`` channel →
+    ``(K, len(STEP_CHANNELS) + 1)``, with ``time`` 0 (it was nominal throughout); actions
+    of this release are returned as they are."""
+    if A.shape[1] != _ALWAYS_DRAWN + 1:
+        return A
+    return np.insert(A, _TIME, 0.0, axis=1)
 
 
 def mirror_state(s: np.ndarray, m: float) -> np.ndarray:

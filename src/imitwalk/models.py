@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imitwalk.balance import STEP_CHANNELS, StepController, step_target
+from imitwalk.balance import StepController, step_target, upgrade_step_actions
 from imitwalk.controller import ActionSelector
 from imitwalk.ensemble import ModelEnsemble
 from imitwalk.errors import RunError
@@ -176,10 +176,8 @@ def unstack_episodes(arrays: dict[str, np.ndarray]) -> dict:
         if f"{kind}_len" not in arrays:
             continue
         cut = np.cumsum(arrays[f"{kind}_len"])[:-1]
-        if kind == "step" and arrays["step_A"].shape[1] == len(STEP_CHANNELS):
-            # written before the time channel: it was 0 (nominal) throughout
-            A = arrays["step_A"]
-            arrays = {**arrays, "step_A": np.c_[A[:, :-1], np.zeros(len(A)), A[:, -1:]]}
+        if kind == "step":  # a run written before the time channel: add it, as 0
+            arrays = {**arrays, "step_A": upgrade_step_actions(arrays["step_A"])}
         data[kind] = list(
             zip(np.split(arrays[f"{kind}_S"], cut), np.split(arrays[f"{kind}_A"], cut), strict=True)
         )
