@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from imitwalk.cli import main
+from imitwalk.errors import ImitwalkError
 from imitwalk.metrics import tilt_deg
 from imitwalk.robots import load_robot
 from imitwalk.sim import MujocoPlant, Plant, SimOptions, playback
@@ -54,6 +55,12 @@ def test_rollout_record(robot):
     assert not ro.fell and ro.fall_time is None
     assert np.allclose(np.diff(ro.t), 0.01)
     assert np.abs(ro.q - ro.q_cmd).max() < 0.1
+    assert ro.torque.shape == (n, 25) and ro.torque_limit.shape == (25,)
+    legs = [robot.joint_names.index(j) for j in ("l_knee", "r_knee", "l_ankle_pitch")]
+    assert np.allclose(ro.torque_limit[legs], 4.0)  # the HOAP-2 leg servos' 4 Nm
+    assert (np.abs(ro.torque) <= ro.torque_limit + 1e-9).all()
+    # standing, the knees carry the body: a real load, well under the limit
+    assert 0.1 < np.abs(ro.torque[-1, legs[:2]]).min() < 4.0
 
 
 def test_rates_are_configurable(robot):
@@ -112,6 +119,21 @@ def test_friction_and_mass_and_kp_options(robot):
     ratio = p.model.actuator_gainprm[:, 0] / base.actuator_gainprm[:, 0]
     assert ratio.min() >= 0.81 - 1e-9 and ratio.max() <= 0.99 + 1e-9 and ratio.std() > 0
     assert np.allclose(p.model.actuator_biasprm[:, 1], -p.model.actuator_gainprm[:, 0])
+
+
+def test_kp_jitter_on_named_joints_only(robot):
+    """The jitter's draws do not depend on which joints take them."""
+    base = MujocoPlant(robot).model.actuator_gainprm[:, 0]
+    full = MujocoPlant(robot, SimOptions(kp_jitter=0.1, seed=3)).model.actuator_gainprm[:, 0]
+    knees = ("l_knee", "r_knee")
+    opt = SimOptions(kp_jitter=0.1, seed=3, kp_jitter_joints=knees)
+    p = MujocoPlant(robot, opt)
+    part = p.model.actuator_gainprm[:, 0]
+    on = np.isin(np.arange(len(part)), [p._act[robot.joint_names.index(j)] for j in knees])
+    assert np.allclose(part[on], full[on]) and not np.allclose(part[on], base[on])
+    assert np.allclose(part[~on], base[~on])
+    with pytest.raises(ImitwalkError, match=r"unknown joint 'kneee'.*l_knee"):
+        MujocoPlant(robot, SimOptions(kp_jitter=0.1, kp_jitter_joints=("kneee",)))
 
 
 def test_heavier_robot_presses_harder(robot):

@@ -18,7 +18,7 @@ from imitwalk.learnconfig import LearnConfig
 from imitwalk.metrics import summarise, walk_metrics
 from imitwalk.models import build_policy, fit_models, unstack_episodes
 from imitwalk.parallel import run_parallel
-from imitwalk.perturb import perturbed
+from imitwalk.perturb import FACTORS, perturbed
 from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
@@ -36,6 +36,7 @@ KEYS = (
     "gyro_rms",
     "joint_rms_error_rad",
     "max_tilt_deg",
+    "torque_saturation",
 )
 
 
@@ -74,7 +75,7 @@ _CACHE: dict = {}
 
 
 def _one(job) -> dict:
-    run_dir, robot, mode, seed, seconds, base, scale = job
+    run_dir, robot, mode, seed, seconds, base, scale, factors = job
     # a worker keeps the last run it loaded, until that run's metrics.json changes
     key = (str(run_dir), RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
@@ -82,7 +83,7 @@ def _one(job) -> dict:
         _CACHE[key] = load_gait(run_dir)
     lg = _CACHE[key]
     scale = lg.scale if scale is None else scale
-    opts = perturbed(seed, base, disturbance=seed != 0)
+    opts = perturbed(seed, base, disturbance=seed != 0, factors=factors)
     ref = lg.gait.ref if mode == "learned" else lg.ref  # at the cadence each one plays
     steps = round(seconds / ref.dt)
     q_ref = ref.trajectory(scale, seconds)
@@ -106,9 +107,15 @@ def per_seed(
     workers=None,
     modes=("learned", "open_loop"),
     scale=None,
+    factors: tuple[str, ...] = FACTORS,
 ) -> dict[str, list[dict]]:
-    """Per-seed metrics of each mode."""
-    jobs = [(str(run_dir), robot, mode, s, seconds, base, scale) for mode in modes for s in seeds]
+    """Per-seed metrics of each mode (``factors``: what the perturbed robots differ in,
+    see :func:`imitwalk.perturb.perturbed`)."""
+    jobs = [
+        (str(run_dir), robot, mode, s, seconds, base, scale, tuple(factors))
+        for mode in modes
+        for s in seeds
+    ]
     res = run_parallel(_one, jobs, workers)
     return {mode: [r for r, j in zip(res, jobs, strict=True) if j[2] == mode] for mode in modes}
 
@@ -131,6 +138,8 @@ def _summary(runs: list[dict], metrics: dict) -> dict:
                 "progress_ratio",
                 "yaw_drift_deg",
                 "forward_speed_mps",
+                "torque_saturation",
+                "saturated_joint",
             )
         }
         for r in runs

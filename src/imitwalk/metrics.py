@@ -43,6 +43,9 @@ class WalkMetrics:
         gyro_rms: RMS of the torso angular velocity norm [rad/s].
         max_tilt_deg: largest torso tilt [deg].
         joint_rms_error_rad: RMS of measured minus reference joint angles [rad].
+        torque_saturation: the largest, over the joints, fraction of ticks at which a
+            servo gave at least 99 % of its torque limit (``None`` if not recorded);
+            saturated_joint: that joint's name (``None`` if no servo saturated).
     """
 
     fell: bool
@@ -56,6 +59,8 @@ class WalkMetrics:
     gyro_rms: float
     max_tilt_deg: float
     joint_rms_error_rad: float
+    torque_saturation: float | None = None
+    saturated_joint: str | None = None
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
@@ -85,6 +90,7 @@ def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = N
     seconds = rollout.seconds
     ref = rollout.q_cmd if q_ref is None else q_ref[: len(rollout.q)]
     err = rollout.q - ref
+    sat, joint = _saturation(rollout)
     return WalkMetrics(
         fell=bool(rollout.fell),
         fall_time_s=rollout.fall_time,
@@ -97,7 +103,26 @@ def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = N
         gyro_rms=float(np.sqrt(np.mean(np.sum(rollout.gyro**2, axis=1)))),
         max_tilt_deg=float(tilt_deg(quat).max()),
         joint_rms_error_rad=float(np.sqrt(np.mean(err**2))),
+        torque_saturation=sat,
+        saturated_joint=joint,
     )
+
+
+#: A servo is saturated when it gives at least this fraction of its torque limit.
+SATURATED = 0.99
+
+
+def _saturation(rollout) -> tuple[float | None, str | None]:
+    """The most saturated joint's fraction of saturated ticks, and its name."""
+    tau, limit = getattr(rollout, "torque", None), getattr(rollout, "torque_limit", None)
+    if tau is None or limit is None or len(tau) == 0:
+        return None, None
+    frac = (np.abs(tau) >= SATURATED * limit).mean(axis=0)
+    j = int(np.argmax(frac))
+    if frac[j] == 0.0:
+        return 0.0, None
+    names = rollout.joint_names
+    return float(frac[j]), (names[j] if j < len(names) else str(j))
 
 
 def summarise(values: Sequence[float]) -> dict:

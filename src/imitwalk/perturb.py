@@ -2,7 +2,9 @@
 
 Seed 0 is the nominal robot. Every other seed draws a perturbed one: each body's mass
 ±5 %, the floor friction 0.7-1.0, each servo's stiffness ±10 %, and (for the
-evaluation of a learned gait) a small initial disturbance of the base velocity.
+evaluation of a learned gait) a small initial disturbance of the base velocity. Each
+of these *factors* (:data:`FACTORS`) can be left out; the others keep their draws, so
+a robot with one factor left out differs from the full one in that factor only.
 Evaluation seeds are 0-99; learning and the reference search only use seeds from
 :data:`TRAIN_SEED_BASE` up, so they never see an evaluation robot; the learner's trials
 of its channel gain use seeds from :data:`TRIAL_SEED_BASE` up, robots it never learned on.
@@ -14,9 +16,21 @@ from dataclasses import replace
 
 import numpy as np
 
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["TRAIN_SEED_BASE", "TRIAL_SEED_BASE", "perturbed", "train_seeds", "trial_seeds"]
+__all__ = [
+    "FACTORS",
+    "TRAIN_SEED_BASE",
+    "TRIAL_SEED_BASE",
+    "perturbed",
+    "train_seeds",
+    "trial_seeds",
+]
+
+#: What a perturbed robot differs in: body masses, floor friction, servo stiffness, and
+#: the initial push of the base (only drawn with ``disturbance=True``).
+FACTORS = ("mass", "friction", "servo", "disturbance")
 
 #: Seeds at or above this are reserved for learning and searching.
 TRAIN_SEED_BASE = 1000
@@ -25,7 +39,12 @@ TRAIN_SEED_BASE = 1000
 TRIAL_SEED_BASE = 100_000
 
 
-def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = False) -> SimOptions:
+def perturbed(
+    seed: int,
+    base: SimOptions | None = None,
+    disturbance: bool = False,
+    factors: tuple[str, ...] = FACTORS,
+) -> SimOptions:
     """Simulation options of robot ``seed`` (0: nominal, as ``base``).
 
     Args:
@@ -33,7 +52,12 @@ def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = Fal
         base: options to perturb (rates, noise, slope ... are kept).
         disturbance: also give the base a small random initial velocity
             (σ 0.02 m/s linear, 0.1 rad/s angular).
+        factors: which of :data:`FACTORS` to perturb (default: all); the others stay
+            nominal. The draws do not depend on it.
     """
+    for f in factors:
+        if f not in FACTORS:
+            raise unknown_name("perturbation factor", f, FACTORS, ConfigError)
     base = base or SimOptions()
     if seed == 0:
         return replace(base, seed=0)
@@ -41,13 +65,14 @@ def perturbed(seed: int, base: SimOptions | None = None, disturbance: bool = Fal
     twist = (0.0,) * 6
     if disturbance:
         twist = tuple(np.concatenate([rng.normal(0, 0.02, 3), rng.normal(0, 0.1, 3)]).tolist())
+    friction = float(rng.uniform(0.7, 1.0))
     return replace(
         base,
         seed=seed,
-        mass_jitter=0.05,
-        kp_jitter=0.10,
-        friction=float(rng.uniform(0.7, 1.0)),
-        init_twist=twist,
+        mass_jitter=0.05 if "mass" in factors else 0.0,
+        kp_jitter=0.10 if "servo" in factors else 0.0,
+        friction=friction if "friction" in factors else base.friction,
+        init_twist=twist if "disturbance" in factors else base.init_twist,
     )
 
 

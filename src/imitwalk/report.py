@@ -38,6 +38,8 @@ def _img(fig, alt: str) -> str:
 
 def _fmt(v) -> str:
     if isinstance(v, dict) and "mean" in v:
+        if v["mean"] is None:  # a figure no seed recorded
+            return "–"
         return f"{v['mean']:.3g} <small>({v['min']:.3g} … {v['max']:.3g})</small>"
     if isinstance(v, float):
         return f"{v:.4g}"

@@ -1,7 +1,8 @@
 """The robustness grid: one perturbation per cell, learned and open loop side by side.
 
 Cells (each on top of the evaluation robots, seed 0 nominal and the rest perturbed):
-floor friction × 0.5, 0.75, 1.25, 1.5; every mass × 0.8, 0.9, 1.1, 1.2; gyro noise;
+floor friction × 0.5, 0.75, 1.25, 1.5; every mass × 0.8, 0.9, 1.1, 1.2; every servo's
+stiffness × 0.9, 1.1; gyro noise;
 a servo delay of one and of two control periods; a ±3° slope along the walk; and a
 lateral push on the torso in the middle of the walk, in two sizes.
 """
@@ -31,6 +32,8 @@ def _cells(seconds: float) -> dict[str, SimOptions]:
         cells[f"friction_x{f:g}"] = replace(base, friction_scale=f)
     for m in (0.8, 0.9, 1.1, 1.2):
         cells[f"mass_x{m:g}"] = replace(base, mass_scale=m)
+    for k in (0.9, 1.1):
+        cells[f"servo_kp_x{k:g}"] = replace(base, kp_scale=k)
     cells["gyro_noise"] = replace(base, gyro_noise=GYRO_NOISE)
     cells["delay_1"] = replace(base, servo_delay=1)
     cells["delay_2"] = replace(base, servo_delay=2)

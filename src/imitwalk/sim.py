@@ -22,6 +22,7 @@ from typing import Protocol, runtime_checkable
 import mujoco
 import numpy as np
 
+from imitwalk.errors import unknown_name
 from imitwalk.robots import Robot
 from imitwalk.simtypes import Observation, Rollout, SimOptions
 
@@ -72,7 +73,13 @@ class MujocoPlant:
         self._qadr = m.jnt_qposadr[self._jid]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
         self._act = np.array([act_for[j] for j in self._jid])
-        kps = opt.kp_scale * rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(self._act))
+        jitter = rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(self._act))
+        if opt.kp_jitter_joints:
+            for j in opt.kp_jitter_joints:
+                if j not in robot.joint_names:
+                    raise unknown_name("joint", j, robot.joint_names)
+            jitter[[j not in opt.kp_jitter_joints for j in robot.joint_names]] = 1.0
+        kps = opt.kp_scale * jitter
         m.actuator_gainprm[self._act, 0] *= kps
         m.actuator_biasprm[self._act, 1] *= kps
         self._sign = robot.signs
@@ -143,6 +150,14 @@ class MujocoPlant:
         ff = np.array([[d.sensordata[s][0] for s in side] for side in self._ff])
         return Observation(d.time, gyro, accel, ff, d.qpos[self._qadr] * self._sign)
 
+    def torques(self) -> np.ndarray:
+        """``(n,)`` each servo's output torque now [Nm], in the robot's joint signs."""
+        return self.data.actuator_force[self._act] * self._sign
+
+    def torque_limits(self) -> np.ndarray:
+        """``(n,)`` each servo's torque limit [Nm] (the larger side of its force range)."""
+        return np.abs(self.model.actuator_forcerange[self._act]).max(axis=1)
+
     def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Ground truth torso position ``(3,)`` [m] and quaternion ``(4,)`` (w, x, y, z)."""
         return self.data.xpos[self._torso].copy(), self.data.xquat[self._torso].copy()
@@ -188,7 +203,8 @@ def run(
         q0 = getattr(policy, "q0", None)
     obs = plant.reset(q0)
     n, nq = len(plant.joint_names), plant.model.nq
-    rec = {k: [] for k in ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos")}
+    keys = ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos", "torque")
+    rec = {k: [] for k in keys}
     for k in range(steps):
         target = np.asarray(policy(k, obs), dtype=float)
         plant.command(target)
@@ -206,6 +222,7 @@ def run(
                 pos,
                 quat,
                 plant.data.qpos.copy(),
+                plant.torques(),
             ),
             strict=True,
         ):
@@ -228,6 +245,8 @@ def run(
         fall_time=plant.fall_time,
         control_dt=plant.control_dt,
         joint_names=plant.joint_names,
+        torque=arr["torque"].reshape(-1, n),
+        torque_limit=plant.torque_limits(),
     )
 
 

@@ -27,6 +27,8 @@ class SimOptions:
         mass_scale: multiplies every body mass and inertia.
         mass_jitter: each body's mass also scaled by U(1 - j, 1 + j) (drawn from ``seed``).
         kp_scale: multiplies every servo stiffness; kp_jitter: per servo U(1 - j, 1 + j).
+        kp_jitter_joints: if set, only these joints' servos take their jitter (the draws
+            are the same, so the other joints are as with no jitter at all).
         slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
         push_time, push_duration: when [s] and how long [s] the torso is pushed.
         push_force: ``(3,)`` world-frame force on the torso during the push [N].
@@ -47,6 +49,7 @@ class SimOptions:
     mass_jitter: float = 0.0
     kp_scale: float = 1.0
     kp_jitter: float = 0.0
+    kp_jitter_joints: tuple[str, ...] = ()
     slope_deg: float = 0.0
     push_time: float = 0.0
     push_duration: float = 0.0
@@ -88,6 +91,8 @@ class Rollout:
     and ``torso_quat`` (N, 4) (w, x, y, z) are simulator ground truth, for metrics
     only; ``qpos`` (N, nq) for rendering. ``fell``/``fall_time`` [s] say whether and
     when the torso fell; ``control_dt`` [s]; ``info`` holds per-run extras.
+    ``torque`` (N, n) is each servo's output torque [Nm] and ``torque_limit`` (n,) its
+    limit [Nm] (simulator ground truth, for metrics only; ``None`` if not recorded).
     """
 
     t: np.ndarray
@@ -104,6 +109,8 @@ class Rollout:
     control_dt: float
     joint_names: tuple[str, ...] = ()
     info: dict = field(default_factory=dict)
+    torque: np.ndarray | None = None
+    torque_limit: np.ndarray | None = None
 
     @property
     def seconds(self) -> float:
