@@ -38,3 +38,27 @@ def test_nominal_robot_and_unknown_factor():
     assert perturbed(0, factors=("mass",)) == SimOptions(seed=0)
     with pytest.raises(ConfigError, match=r"unknown perturbation factor 'kp'.*servo"):
         perturbed(3, factors=("kp",))
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(1, 10**6), high=st.floats(1.0, 1.5))
+def test_a_wider_friction_range_maps_the_same_draw(seed, high):
+    """The learner's robots may draw friction from a wider range: the same robot, the same
+    quantile of it, and every other factor as before."""
+    base = perturbed(seed, disturbance=True)
+    wide = perturbed(seed, disturbance=True, friction_range=(0.7, high))
+    u = (base.friction - 0.7) / 0.3
+    assert wide.friction == pytest.approx(0.7 + u * (high - 0.7))
+    assert (wide.mass_jitter, wide.kp_jitter, wide.init_twist) == (
+        base.mass_jitter,
+        base.kp_jitter,
+        base.init_twist,
+    )
+
+
+def test_train_friction_is_checked():
+    from imitwalk.learnconfig import LearnConfig
+
+    assert LearnConfig(train_friction=(0.7, 1.3)).train_friction == (0.7, 1.3)
+    with pytest.raises(ConfigError, match="train_friction"):
+        LearnConfig(train_friction=(1.3, 0.7))

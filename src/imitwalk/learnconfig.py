@@ -94,6 +94,8 @@ class LearnConfig:
         train_models: robots per iteration: the nominal one + training perturbations.
         fresh_robots: draw new training perturbations at every iteration (else the same
             ones throughout); a scale then passes only on robots it has not learned on.
+        train_friction: the range the training and trial robots draw their floor friction
+            from (the evaluation robots draw from 0.7-1.0; the nominal robot's is 1.0).
         gains: candidate channel gains tried once the schedule has ended, each on the
             same ``gain_robots`` robots for ``gain_seconds``; the one that measures best
             is kept (:mod:`imitwalk.trust`). Empty: keep ``step.gain``.
@@ -112,6 +114,7 @@ class LearnConfig:
     step: StepConfig = field(default_factory=StepConfig)
     train_models: int = 3
     fresh_robots: bool = False
+    train_friction: tuple[float, float] = (0.7, 1.0)
     gains: tuple[float, ...] = ()
     cadences: tuple[float, ...] = ()
     gain_robots: int = 12
@@ -129,6 +132,11 @@ class LearnConfig:
             raise ConfigError(
                 "step channel 'time' needs tick.enabled=false: the per-tick search acts "
                 "on the plan's ticks, which the time channel stretches"
+            )
+        lo_hi = tuple(self.train_friction)
+        if len(lo_hi) != 2 or not 0.0 < lo_hi[0] <= lo_hi[1] <= 3.0:
+            raise ConfigError(
+                f"train_friction={self.train_friction}: expected two values 0 < low <= high <= 3"
             )
         if (self.gains or self.cadences) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")

@@ -49,7 +49,8 @@ def _episode(job) -> dict:
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
     steps = round(seconds / ref.dt)
-    ro = run(MujocoPlant(robot, perturbed(seed, disturbance=seed != 0)), policy, steps)
+    opts = perturbed(seed, disturbance=seed != 0, friction_range=tuple(cfg.train_friction))
+    ro = run(MujocoPlant(robot, opts), policy, steps)
     m = walk_metrics(
         ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
     )

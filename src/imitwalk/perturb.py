@@ -44,6 +44,7 @@ def perturbed(
     base: SimOptions | None = None,
     disturbance: bool = False,
     factors: tuple[str, ...] = FACTORS,
+    friction_range: tuple[float, float] = (0.7, 1.0),
 ) -> SimOptions:
     """Simulation options of robot ``seed`` (0: nominal, as ``base``).
 
@@ -54,6 +55,8 @@ def perturbed(
             (σ 0.02 m/s linear, 0.1 rad/s angular).
         factors: which of :data:`FACTORS` to perturb (default: all); the others stay
             nominal. The draws do not depend on it.
+        friction_range: the floor friction is drawn uniformly from this range (the
+            learner may widen it for its own robots; evaluation keeps the default).
     """
     for f in factors:
         if f not in FACTORS:
@@ -65,7 +68,7 @@ def perturbed(
     twist = (0.0,) * 6
     if disturbance:
         twist = tuple(np.concatenate([rng.normal(0, 0.02, 3), rng.normal(0, 0.1, 3)]).tolist())
-    friction = float(rng.uniform(0.7, 1.0))
+    friction = float(rng.uniform(*friction_range))
     return replace(
         base,
         seed=seed,
