@@ -10,13 +10,15 @@ learned falls 0, scale >= 0.8, progress ratio min >= 0.5, |mean yaw drift| <= 20
 and open loop falling on at least one robot. Then a summary line.
 
 Usage: ``python bench/learning_seeds.py REFERENCE.npz --seeds 0 1 2 --robots 40 --out DIR``
-(runs are kept in ``DIR/seed_S``; a finished one is evaluated, not relearned).
+(runs are kept in ``DIR/seed_S``; a finished one is evaluated, not relearned, and an
+interrupted one resumes). Learning progress goes to stderr.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -29,6 +31,10 @@ from imitwalk.learner import learn
 from imitwalk.retarget import Reference
 from imitwalk.robots import load_robot
 from imitwalk.runs import RunDir
+
+
+def _progress(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
 
 
 def _ten(runs: list[dict]) -> dict:
@@ -67,10 +73,14 @@ def main() -> None:
         cfg = apply_overrides(preset("extended"), [*args.set, f"seed={seed}"])
         out = Path(args.out) / f"seed_{seed}"
         t = time.perf_counter()
-        done = RunDir(out).exists("metrics.json") and "channel_gain" in RunDir(out).read_json(
-            "metrics.json"
-        )
-        summary = RunDir(out).read_json("metrics.json") if done else learn(ref, robot, cfg, out)
+        rd = RunDir(out)
+        done = rd.exists("metrics.json") and "channel_gain" in rd.read_json("metrics.json")
+        if done:
+            summary = rd.read_json("metrics.json")
+        else:  # learn, or go on with an interrupted run
+            summary = learn(
+                ref, robot, cfg, out, resume=rd.exists("checkpoint.json"), progress=_progress
+            )
         wall = time.perf_counter() - t
         runs = per_seed(out, robot, 30.0, list(range(max(args.robots, 10))))
         fell = {m: [bool(r["fell"]) for r in runs[m]] for m in runs}
