@@ -38,3 +38,23 @@ def test_the_residual_is_continuous_between_ticks(tiny_reference):
         assert np.allclose(lo, hi, atol=1e-6)
     mid = gm._residual_at(0.4, 0.5 * (nom[4, 0] + nom[5, 0]))
     assert np.allclose(mid, 0.5 * (gm.residuals[0.4][4] + gm.residuals[0.4][5]), atol=1e-9)
+
+
+def test_the_residual_follows_the_tick_where_the_phase_runs_backwards(tiny_reference):
+    ref, _ = tiny_reference
+    gm = GaitModel(ref, (0.4,), GaitConfig(3, "time", residual=True))
+    res = gm.residuals[0.4]
+    n = len(res)
+    assert not gm._by_tick[0.4].any()  # a monotone phase: looked up by φ, as before
+    # make φ run backwards over ticks 10-12 (as the time phase's fit can at full scale)
+    nom = gm.nominal[0.4]
+    nom[10:13, 0] = nom[9, 0] - 0.5 * (nom[10:13, 0] - nom[9, 0])
+    gm._index_phase(0.4)
+    assert gm._by_tick[0.4][10:13].all()
+    wrong = [i for i in range(n) if not np.allclose(gm._residual_at(0.4, nom[i, 0]), res[i])]
+    assert wrong  # by φ alone, some ticks find another tick's residual
+    for cycle in range(3):
+        for i in range(n):
+            t = i + cycle * n
+            phi = gm.nominal_action(0.4, t)[0]
+            assert np.allclose(gm._residual_at(0.4, phi, t), res[i], atol=1e-9)

@@ -67,6 +67,7 @@ class GaitModel:
         self.nominal: dict[float, np.ndarray] = {}
         self.residuals: dict[float, np.ndarray] = {}
         self._phase_tables: dict[float, tuple[float, np.ndarray]] = {}
+        self._by_tick: dict[float, np.ndarray] = {}
         for s, loop in zip(self.scales, loops, strict=True):
             X = self.subspace.transform(loop)  # (N, k)
             emb = GaitEmbedding(n_centers=config.n_centers, phase_source=config.phase_source)
@@ -81,9 +82,27 @@ class GaitModel:
             # differs in the last bit, and a marginal robot's fate can hang on that)
             back = np.array([emb.from_cylinder(c) for c in cyl])
             self.residuals[s] = loop - self.subspace.inverse_transform(back)  # (N, n)
-            sign = 1.0 if cyl[-1, 0] >= cyl[0, 0] else -1.0
-            table = np.maximum.accumulate(sign * (cyl[:, 0] - cyl[0, 0]))  # ascending from 0
-            self._phase_tables[s] = (sign, table)
+            self._index_phase(s)
+
+    def _index_phase(self, s: float) -> None:
+        """The φ → tick table of scale ``s`` for looking up its residual by phase.
+
+        Where φ runs backwards over a few ticks (it can, with the time phase), the lookup
+        finds another tick: those ticks, and their neighbours (a later cycle's φ differs
+        in the last bit), are marked to take their own residual when the tick is known.
+        """
+        phi0 = self.nominal[s][:, 0]
+        sign = 1.0 if phi0[-1] >= phi0[0] else -1.0
+        table = np.maximum.accumulate(sign * (phi0 - phi0[0]))  # ascending from 0
+        self._phase_tables[s] = (sign, table)
+        self._by_tick.pop(s, None)
+        wrong = np.zeros(len(phi0), dtype=bool)
+        for c in range(4):
+            found = np.array([self._residual_at(s, f + 2 * np.pi * c * sign) for f in phi0])
+            wrong |= np.abs(found - self.residuals[s]).max(axis=1) > 1e-9
+        if wrong.any():
+            wrong = wrong | np.roll(wrong, 1) | np.roll(wrong, -1)
+        self._by_tick[s] = wrong
 
     @property
     def n_ticks(self) -> int:
@@ -109,18 +128,30 @@ class GaitModel:
         out[0] += 2 * np.pi * cycles * np.sign(nom[-1, 0] - nom[0, 0] or 1.0)
         return out
 
-    def joints(self, scale: float, action: np.ndarray) -> np.ndarray:
-        """Joint targets ``(n,)`` [rad] of an action (φ, r, h): g and C⁺ (the way back)."""
+    def joints(self, scale: float, action: np.ndarray, tick: int | None = None) -> np.ndarray:
+        """Joint targets ``(n,)`` [rad] of an action (φ, r, h): g and C⁺ (the way back).
+
+        ``tick``: the loop tick the action is for, if known (see :meth:`_residual_at`).
+        """
         action = np.asarray(action, dtype=float)
         q = self.subspace.inverse_transform(self.embedding(scale).from_cylinder(action))
         if self.config.residual:
-            q = q + self._residual_at(scale, float(action[0]))
+            q = q + self._residual_at(scale, float(action[0]), tick)
         return q
 
-    def _residual_at(self, scale: float, phi: float) -> np.ndarray:
-        """The out-of-subspace posture ``(n,)`` at phase φ, interpolated between ticks."""
+    def _residual_at(self, scale: float, phi: float, tick: int | None = None) -> np.ndarray:
+        """The out-of-subspace posture ``(n,)`` at phase φ, interpolated between ticks.
+
+        Where the reference's φ runs backwards (it can, with the time phase), φ alone does
+        not say which tick it is; there, given the ``tick`` whose nominal φ this is, the
+        residual is that tick's own.
+        """
         key = self._key(scale)
         res, (sign, table) = self.residuals[key], self._phase_tables[key]
+        by_tick = self._by_tick.get(key)
+        if tick is not None and by_tick is not None and by_tick[tick % len(res)]:
+            if abs(phi - self.nominal_action(scale, tick)[0]) < 1e-12:
+                return res[tick % len(res)]
         u = (sign * (phi - self.nominal[key][0, 0])) % (2 * np.pi)
         t = float(np.interp(u, table, np.arange(len(table)), right=np.nan))
         if not np.isfinite(t):  # between the last tick and the next cycle's first

@@ -118,7 +118,7 @@ class WalkPolicy:
         q = (
             self._tick(i, est)
             if record
-            else self.gait.joints(self.scale, self.gait.nominal_action(self.scale, i))
+            else self.gait.joints(self.scale, self.gait.nominal_action(self.scale, i), i)
         )
         if i < 0:  # cross-fade from the start-up into the controller over one cycle
             w = (i + n) / n
@@ -155,7 +155,7 @@ class WalkPolicy:
         self.tick_states.append(s)
         self.tick_actions.append(action)
         self._a_prev = action
-        return self.gait.joints(self.scale, action)
+        return self.gait.joints(self.scale, action, i)
 
     def _channels(self, j: float, est) -> np.ndarray:
         """Step-level balance channels at stepping tick ``j`` (the plan's clock; 0 = first
