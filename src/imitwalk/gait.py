@@ -90,6 +90,8 @@ class GaitModel:
         Where φ runs backwards over a few ticks (it can, with the time phase), the lookup
         finds another tick: those ticks, and their neighbours (a later cycle's φ differs
         in the last bit), are marked to take their own residual when the tick is known.
+        Only those: elsewhere the lookup by φ stays, since in later cycles it reproduces
+        the tick's residual only to the last bit, and a learned run depends on those bits.
         """
         phi0 = self.nominal[s][:, 0]
         sign = 1.0 if phi0[-1] >= phi0[0] else -1.0
