@@ -25,19 +25,18 @@ re-solves the reference's task-space plan with these offsets
 (:class:`imitwalk.retarget.online.OnlineIK`). The step state (mirrored) is torso roll,
 pitch, heading, the mean gyro over the step, the stance foot's share of the load and the
 mean front/rear balance of the sole forces over the step — all from the robot's own
-sensors.
+sensors. The settings, and the names of the channels and states, are in
+:mod:`imitwalk.stepconfig`.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from imitwalk.controller import stability_cost
 from imitwalk.ensemble import ModelEnsemble
-from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.predictor import SensoryMotorModel
+from imitwalk.stepconfig import ALWAYS_DRAWN, LATERAL, STEP_CHANNELS, STEP_STATE, TIME, StepConfig
 
 __all__ = [
     "STEP_CHANNELS",
@@ -48,89 +47,6 @@ __all__ = [
     "step_target",
     "upgrade_step_actions",
 ]
-
-STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
-#: The channels of the first releases: their search candidates and exploration noise are
-#: always drawn (zero when off), so that runs written before ``time`` replay exactly.
-_ALWAYS_DRAWN = 5
-_TIME = STEP_CHANNELS.index("time")
-#: Step state, in the stance side's mirrored frame.
-STEP_STATE = (
-    "roll",
-    "pitch",
-    "heading",
-    "roll_rate",
-    "pitch_rate",
-    "yaw_rate",
-    "stance_load",
-    "cop_x",
-)
-_LATERAL = np.array([1, 0, 1, 1, 0, 1, 0, 0], dtype=bool)  # flip sign when mirrored
-
-
-@dataclass(frozen=True)
-class StepConfig:
-    """Step-level channel learning.
-
-    Attributes:
-        channels: which of :data:`STEP_CHANNELS` the learner may use (default: all but
-            ``time``).
-        c_max: box half-width per channel in :data:`STEP_CHANNELS` order
-            [m, m, rad, m, m, fraction of the step's duration].
-            ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
-            apart, and a narrower step lands one foot on the other.
-        weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
-            on the deviation from the target state (the walk's own mean state, heading 0).
-        effort: weight of Σ (c / c_max)² in the objective.
-        horizon: steps predicted ahead (later steps take the nominal, zero, channels).
-        candidates: random candidates per decision (plus the nominal zero).
-        explore: exploration noise, a fraction of c_max, in the first iteration at a scale.
-        n_centers, ridge: of the step model's RBF network (which also has linear terms).
-        ensemble: step models fitted to bootstrap resamples of the recorded episodes
-            (:class:`~imitwalk.ensemble.ModelEnsemble`); a candidate is scored by its
-            predicted gain over the zero channels in the least favourable one (1: one
-            model on all the data, scored as it predicts).
-        margin: act only if every member predicts a gain over the zero channels of at
-            least this fraction of the zero channels' own predicted cost (0: any gain).
-            The model is least trustworthy where its predicted gains are small; a
-            margin keeps the walk on the reference there.
-        gain: the channel values the search chooses are multiplied by this (a trust
-            factor on the model's corrections: 1 applies them as predicted, 0 turns them
-            off). The learner can pick it from measured trials (``LearnConfig.gains``).
-    """
-
-    channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
-    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15)
-    weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
-    effort: float = 0.05
-    horizon: int = 2
-    candidates: int = 256
-    explore: float = 0.3
-    n_centers: int = 24
-    ridge: float = 1e-2
-    ensemble: int = 1
-    margin: float = 0.0
-    gain: float = 1.0
-
-    def __post_init__(self):
-        for c in self.channels:
-            if c not in STEP_CHANNELS:
-                raise unknown_name("step channel", c, STEP_CHANNELS, ConfigError)
-        if len(self.c_max) == _ALWAYS_DRAWN:  # a run written before the time channel
-            c_max = list(self.c_max)
-            c_max.insert(_TIME, 0.0)
-            object.__setattr__(self, "c_max", tuple(c_max))
-        if len(self.c_max) != len(STEP_CHANNELS):
-            raise ConfigError(
-                f"step.c_max has {len(self.c_max)} values: expected one per channel of "
-                f"{', '.join(STEP_CHANNELS)}"
-            )
-        if "time" in self.channels and not 0.0 <= self.c_max[_TIME] < 0.5:
-            raise ConfigError(f"step.c_max for time={self.c_max[_TIME]}: expected 0 <= c < 0.5")
-        if not 0.0 <= self.margin < 1.0:
-            raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
-        if not 0.0 <= self.gain <= 2.0:
-            raise ConfigError(f"step.gain={self.gain}: expected 0 <= gain <= 2")
 
 
 def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: float) -> np.ndarray:
@@ -154,9 +70,9 @@ def upgrade_step_actions(A: np.ndarray) -> np.ndarray:
     """Recorded step actions ``(K, 6)`` of a run written before the ``time`` channel →
     ``(K, len(STEP_CHANNELS) + 1)``, with ``time`` 0 (it was nominal throughout); actions
     of this release are returned as they are."""
-    if A.shape[1] != _ALWAYS_DRAWN + 1:
+    if A.shape[1] != ALWAYS_DRAWN + 1:
         return A
-    return np.insert(A, _TIME, 0.0, axis=1)
+    return np.insert(A, TIME, 0.0, axis=1)
 
 
 def mirror_state(s: np.ndarray, m: float) -> np.ndarray:
@@ -165,7 +81,7 @@ def mirror_state(s: np.ndarray, m: float) -> np.ndarray:
     The last entry (``load_left`` raw) becomes the stance foot's share.
     """
     out = np.array(s, dtype=float)
-    out[..., _LATERAL] *= m
+    out[..., LATERAL] *= m
     if m < 0:
         out[..., 6] = 1.0 - out[..., 6]
     return out
@@ -203,7 +119,7 @@ class StepController:
         self.c_min = -self.c_max * (np.array(STEP_CHANNELS) != "dy")  # dy: outwards only
         # the search stays where the model has seen data; exploration may go to the limits
         self.box = self.c_max if limits is None else np.minimum(self.c_max, limits)
-        self._drawn = (np.arange(len(STEP_CHANNELS)) < _ALWAYS_DRAWN) | (self.mask > 0)
+        self._drawn = (np.arange(len(STEP_CHANNELS)) < ALWAYS_DRAWN) | (self.mask > 0)
         self.states: list[np.ndarray] = []  # mirrored step states s_k
         self.actions: list[np.ndarray] = []  # channel values c_k (mirrored coordinates)
         self.predicted: list[float] = []
@@ -257,7 +173,7 @@ class StepController:
         tick (1 before the step is decided)."""
         if k >= len(self.actions):
             return 1.0
-        return 1.0 / (1.0 + float(self.actions[k][_TIME]))
+        return 1.0 / (1.0 + float(self.actions[k][TIME]))
 
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,103 @@
+"""The step-level balance channels' settings and names (pure NumPy).
+
+:class:`StepConfig` is what :class:`imitwalk.balance.StepController` decides with: which
+channels it may use, their box, the step objective's weights (eq. 6 extended) and the
+step model's size. The names of the channels and of the step state live here too, so
+that a run's settings can be read without the controller.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.errors import ConfigError, unknown_name
+
+__all__ = ["ALWAYS_DRAWN", "LATERAL", "STEP_CHANNELS", "STEP_STATE", "TIME", "StepConfig"]
+
+#: The channels, in the order of every channel vector (see :mod:`imitwalk.balance`).
+STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
+#: The channels of the first releases: their search candidates and exploration noise are
+#: always drawn (zero when off), so that runs written before ``time`` replay exactly.
+ALWAYS_DRAWN = 5
+#: Index of the ``time`` channel.
+TIME = STEP_CHANNELS.index("time")
+#: Step state, in the stance side's mirrored frame.
+STEP_STATE = (
+    "roll",
+    "pitch",
+    "heading",
+    "roll_rate",
+    "pitch_rate",
+    "yaw_rate",
+    "stance_load",
+    "cop_x",
+)
+#: The :data:`STEP_STATE` entries whose sign flips when a right step is mirrored.
+LATERAL = np.array([1, 0, 1, 1, 0, 1, 0, 0], dtype=bool)
+
+
+@dataclass(frozen=True)
+class StepConfig:
+    """Step-level channel learning.
+
+    Attributes:
+        channels: which of :data:`STEP_CHANNELS` the learner may use (default: all but
+            ``time``).
+        c_max: box half-width per channel in :data:`STEP_CHANNELS` order
+            [m, m, rad, m, m, fraction of the step's duration].
+            ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
+            apart, and a narrower step lands one foot on the other.
+        weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
+            on the deviation from the target state (the walk's own mean state, heading 0).
+        effort: weight of Σ (c / c_max)² in the objective.
+        horizon: steps predicted ahead (later steps take the nominal, zero, channels).
+        candidates: random candidates per decision (plus the nominal zero).
+        explore: exploration noise, a fraction of c_max, in the first iteration at a scale.
+        n_centers, ridge: of the step model's RBF network (which also has linear terms).
+        ensemble: step models fitted to bootstrap resamples of the recorded episodes
+            (:class:`~imitwalk.ensemble.ModelEnsemble`); a candidate is scored by its
+            predicted gain over the zero channels in the least favourable one (1: one
+            model on all the data, scored as it predicts).
+        margin: act only if every member predicts a gain over the zero channels of at
+            least this fraction of the zero channels' own predicted cost (0: any gain).
+            The model is least trustworthy where its predicted gains are small; a
+            margin keeps the walk on the reference there.
+        gain: the channel values the search chooses are multiplied by this (a trust
+            factor on the model's corrections: 1 applies them as predicted, 0 turns them
+            off). The learner can pick it from measured trials (``LearnConfig.gains``).
+    """
+
+    channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
+    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15)
+    weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
+    effort: float = 0.05
+    horizon: int = 2
+    candidates: int = 256
+    explore: float = 0.3
+    n_centers: int = 24
+    ridge: float = 1e-2
+    ensemble: int = 1
+    margin: float = 0.0
+    gain: float = 1.0
+
+    def __post_init__(self):
+        for c in self.channels:
+            if c not in STEP_CHANNELS:
+                raise unknown_name("step channel", c, STEP_CHANNELS, ConfigError)
+        if len(self.c_max) == ALWAYS_DRAWN:  # a run written before the time channel
+            c_max = list(self.c_max)
+            c_max.insert(TIME, 0.0)
+            object.__setattr__(self, "c_max", tuple(c_max))
+        if len(self.c_max) != len(STEP_CHANNELS):
+            raise ConfigError(
+                f"step.c_max has {len(self.c_max)} values: expected one per channel of "
+                f"{', '.join(STEP_CHANNELS)}"
+            )
+        if "time" in self.channels and not 0.0 <= self.c_max[TIME] < 0.5:
+            raise ConfigError(f"step.c_max for time={self.c_max[TIME]}: expected 0 <= c < 0.5")
+        if not 0.0 <= self.margin < 1.0:
+            raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
+        if not 0.0 <= self.gain <= 2.0:
+            raise ConfigError(f"step.gain={self.gain}: expected 0 <= gain <= 2")
