@@ -17,9 +17,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
-from imitwalk.balance import StepConfig
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.gait import GaitConfig
+from imitwalk.stepconfig import StepConfig
 
 __all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
 
