@@ -2,7 +2,8 @@
 recorded steps it is fitted on.
 
 For a finished (or interrupted) run folder, holds out a third of the episodes recorded at
-scales ≥ ``--min-scale`` (three random splits), fits the run's step model on a share of
+scales ≥ ``--min-scale`` (three random splits), fits the run's step model
+(:func:`imitwalk.models.step_model`, its ensemble included) on a share of
 the remaining episodes and reports the one-step prediction error on the held-out ones as
 a fraction of "nothing changes" (``overall_ratio``, as ``imitwalk learn`` prints it).
 A curve that stays flat as the share grows says the model is limited by what its state
@@ -20,8 +21,7 @@ import numpy as np
 
 from imitwalk.config import from_dict
 from imitwalk.learnconfig import LearnConfig
-from imitwalk.models import unstack_episodes
-from imitwalk.predictor import SensoryMotorModel
+from imitwalk.models import step_model, unstack_episodes
 from imitwalk.runs import RunDir
 from imitwalk.stepconfig import STEP_STATE
 
@@ -36,13 +36,13 @@ def main() -> None:
     ap.add_argument("--splits", type=int, default=3)
     args = ap.parse_args()
     rd = RunDir(args.run)
-    cfg = from_dict(LearnConfig, rd.read_json("config.json")["learn"]).step
+    cfg = from_dict(LearnConfig, rd.read_json("config.json")["learn"])
     eps = [e for e in unstack_episodes(rd.read_arrays("data.npz"))["step"] if len(e[0]) > 3]
     high = [i for i, e in enumerate(eps) if e[1][0, -1] >= args.min_scale - 1e-9]
     if len(high) < 3:
         raise SystemExit(f"bench: {args.run} has {len(high)} episodes at scale >= {args.min_scale}")
     rows = []
-    for centers in args.centers or [cfg.n_centers]:
+    for centers in args.centers or [cfg.step.n_centers]:
         for share in SHARES:
             ratios, dims = [], []
             for split in range(args.splits):
@@ -50,13 +50,7 @@ def main() -> None:
                 test = set(rng.choice(high, len(high) // 3, replace=False).tolist())
                 train = [e for i, e in enumerate(eps) if i not in test]
                 keep = rng.permutation(len(train))[: max(1, int(round(share * len(train))))]
-                model = SensoryMotorModel(
-                    n_centers=centers,
-                    ridge=cfg.ridge,
-                    angle_action=False,
-                    linear=True,
-                    random_state=split,
-                ).fit([train[i] for i in keep])
+                model = step_model(cfg, centers).fit([train[i] for i in keep])
                 rep = model.evaluate([eps[i] for i in sorted(test)])
                 ratios.append(rep.overall_ratio)
                 dims.append(rep.ratio)

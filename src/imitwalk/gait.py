@@ -97,7 +97,6 @@ class GaitModel:
         sign = 1.0 if phi0[-1] >= phi0[0] else -1.0
         table = np.maximum.accumulate(sign * (phi0 - phi0[0]))  # ascending from 0
         self._phase_tables[s] = (sign, table)
-        self._by_tick.pop(s, None)
         wrong = np.zeros(len(phi0), dtype=bool)
         for c in range(4):
             found = np.array([self._residual_at(s, f + 2 * np.pi * c * sign) for f in phi0])

@@ -8,12 +8,14 @@ Rendering goes through :mod:`imitwalk.render` (offscreen, fast settings).
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from imitwalk import plots
+from imitwalk.retarget.reference import atomic_write
 from imitwalk.robots import Robot
 from imitwalk.sim import MujocoPlant, Rollout, SimOptions, playback, run
 from imitwalk.trust import LABELS
@@ -27,6 +29,7 @@ __all__ = [
     "pose_qpos",
     "replay",
     "robot_strip",
+    "save_strip",
     "video",
 ]
 
@@ -192,3 +195,17 @@ def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Repl
         first = policy.first_loop_tick
         actions = actions[: max(0, round(after.fall_time / after.control_dt) - first)]
     return Replays(scale, before, after, actions)
+
+
+def save_strip(figs, path: Path) -> Path:
+    """The film-strip figures stacked into one PNG (white-padded to the widest)."""
+    from PIL import Image
+
+    imgs = [Image.open(io.BytesIO(plots.png_bytes(f))).convert("RGB") for f in figs]
+    w = max(i.width for i in imgs)
+    out = Image.new("RGB", (w, sum(i.height for i in imgs)), "white")
+    y = 0
+    for i in imgs:
+        out.paste(i, (0, y))
+        y += i.height
+    return atomic_write(path, lambda tmp: out.save(tmp, format="PNG"))

@@ -22,7 +22,14 @@ from imitwalk.learnconfig import LearnConfig
 from imitwalk.policy import WalkPolicy
 from imitwalk.predictor import SensoryMotorModel
 
-__all__ = ["Models", "build_policy", "fit_models", "stack_episodes", "unstack_episodes"]
+__all__ = [
+    "Models",
+    "build_policy",
+    "fit_models",
+    "stack_episodes",
+    "step_model",
+    "unstack_episodes",
+]
 
 #: At most this many of the latest tick samples train the gyro model.
 MAX_TICK_SAMPLES = 40000
@@ -59,6 +66,19 @@ def _latest(episodes: list, cap: int) -> list:
     return out[::-1]
 
 
+def step_model(config: LearnConfig, n_centers: int | None = None) -> ModelEnsemble:
+    """The run's step model, unfitted: an ensemble of RBF networks with linear terms on
+    the step states and channel values (``n_centers``: another size, for diagnostics)."""
+    return ModelEnsemble(
+        n_members=config.step.ensemble,
+        random_state=config.seed,
+        n_centers=config.step.n_centers if n_centers is None else n_centers,
+        ridge=config.step.ridge,
+        angle_action=False,
+        linear=True,
+    )
+
+
 def fit_models(data: dict, config: LearnConfig) -> Models:
     """Fit the gyro model (if the tick search is on) and the step model (if channels are)."""
     models = Models()
@@ -69,14 +89,7 @@ def fit_models(data: dict, config: LearnConfig) -> Models:
         ).fit(_latest(tick_eps, MAX_TICK_SAMPLES))
     step_eps = [e for e in data.get("step", []) if len(e[0]) > 3]
     if config.steps and sum(len(e[0]) for e in step_eps) >= 30:
-        models.step = ModelEnsemble(
-            n_members=config.step.ensemble,
-            random_state=config.seed,
-            n_centers=config.step.n_centers,
-            ridge=config.step.ridge,
-            angle_action=False,
-            linear=True,
-        ).fit(step_eps)
+        models.step = step_model(config).fit(step_eps)
     models.step_data = ([e[0] for e in step_eps], [e[1] for e in step_eps])
     return models
 

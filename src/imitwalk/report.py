@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import json
 import time
 from pathlib import Path
@@ -174,7 +173,7 @@ def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
         rows.append(
             (plots.film_strip(images, titles, label), f"film strip: robot {name.split(':')[0]}")
         )
-    _save_strip([f for f, _ in rows], png)
+    media.save_strip([f for f, _ in rows], png)
     out = "".join(_img(f, alt) for f, alt in rows)
     if missing:
         out = f'<p class="missing">{html.escape(missing)}</p>' + out
@@ -285,17 +284,3 @@ def _robustness(rd: RunDir) -> str:
         )
     rob = rd.read_json("robustness.json")
     return _img(curves.robustness_heatmap(rob), "robustness") + _robustness_table(rob)
-
-
-def _save_strip(figs, path: Path) -> Path:
-    """The film-strip figures stacked into one PNG (white-padded to the widest)."""
-    from PIL import Image
-
-    imgs = [Image.open(io.BytesIO(plots.png_bytes(f))).convert("RGB") for f in figs]
-    w = max(i.width for i in imgs)
-    out = Image.new("RGB", (w, sum(i.height for i in imgs)), "white")
-    y = 0
-    for i in imgs:
-        out.paste(i, (0, y))
-        y += i.height
-    return atomic_write(path, lambda tmp: out.save(tmp, format="PNG"))
