@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 from imitwalk import commands
 from imitwalk.errors import ImitwalkError
+from imitwalk.simtypes import ENGINES
 
 __all__ = ["build_parser", "main"]
 
@@ -23,6 +24,15 @@ def _robot_args(p: argparse.ArgumentParser, positional: bool = True) -> None:
     else:
         p.add_argument("--robot", default="hoap2", help="robot (default hoap2)")
     p.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
+
+
+def _engine_arg(p: argparse.ArgumentParser, default: str | None, what: str) -> None:
+    p.add_argument(
+        "--engine",
+        default=default,
+        choices=ENGINES,
+        help=f"physics engine (bullet: the same robot on PyBullet; default: {what})",
+    )
 
 
 def _mocap_args(p: argparse.ArgumentParser) -> None:
@@ -89,6 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("--robot", default=None, help="robot (default: the reference's)")
     pb.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     pb.add_argument("--workers", type=int, default=None, help="parallel processes (one per core)")
+    _engine_arg(pb, "mujoco", "mujoco")
     pb.add_argument("--json", action="store_true", help="print JSON")
     pb.set_defaults(func=commands.playback)
     ln = sub.add_parser("learn", help="learn to walk a mocap clip (retargets it first)")
@@ -126,6 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--robot", default=None, help="robot (default: the run's)")
     ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     ev.add_argument("--workers", type=int, default=None, help="parallel processes")
+    _engine_arg(ev, None, "the one the run learned on")
     ev.add_argument("--json", action="store_true", help="print JSON")
     ev.set_defaults(func=commands.evaluate)
     rp = sub.add_parser("report", help="write RUN_DIR/report.html (figures, film strips, video)")

@@ -135,8 +135,10 @@ def playback(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     seeds = list(range(args.models))
     progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
-    runs = play_reference(ref, robot, args.scale, args.seconds, seeds, workers=args.workers)
-    out = {"scale": args.scale, "seconds": args.seconds, **summary(runs)}
+    runs = play_reference(
+        ref, robot, args.scale, args.seconds, seeds, workers=args.workers, engine=args.engine
+    )
+    out = {"scale": args.scale, "seconds": args.seconds, "engine": args.engine, **summary(runs)}
     emit(out, args.json)
     return 0
 
@@ -204,6 +206,7 @@ def evaluate(args: argparse.Namespace) -> int:
     cfg = rd.read_json("config.json")
     ref_settings = cfg.get("reference", {})
     args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
+    args.engine = args.engine or cfg.get("learn", {}).get("engine", "mujoco")
     robot = robot_from(args)
     if args.perturb:
         progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
@@ -215,18 +218,32 @@ def evaluate(args: argparse.Namespace) -> int:
             workers=args.workers,
             progress=progress,
             scale=args.scale,
+            engine=args.engine,
         )
-        name = "robustness.json" if args.scale is None else f"robustness_scale{args.scale:g}.json"
+        name = _result_name("robustness", args)
         rd.write_json(name, out)
     else:
         progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
         out = evaluate_run(
-            rd.path, robot, args.seconds, args.seeds, workers=args.workers, scale=args.scale
+            rd.path,
+            robot,
+            args.seconds,
+            args.seeds,
+            workers=args.workers,
+            scale=args.scale,
+            engine=args.engine,
         )
-        name = "evaluation.json" if args.scale is None else f"evaluation_scale{args.scale:g}.json"
+        name = _result_name("evaluation", args)
         rd.write_json(name, out)
     emit(out, args.json)
     return 0
+
+
+def _result_name(kind: str, args: argparse.Namespace) -> str:
+    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_bullet.json`` ..."""
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    engine = "" if args.engine == "mujoco" else f"_{args.engine}"
+    return f"{kind}{scale}{engine}.json"
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -23,7 +23,7 @@ from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
-from imitwalk.sim import MujocoPlant, SimOptions, playback, run
+from imitwalk.sim import SimOptions, make_plant, playback, run
 
 __all__ = ["LearnedGait", "compare_falls", "evaluate_run", "load_gait", "per_seed", "wilson"]
 
@@ -75,7 +75,7 @@ _CACHE: dict = {}
 
 
 def _one(job) -> dict:
-    run_dir, robot, mode, seed, seconds, base, scale, factors = job
+    run_dir, robot, mode, seed, seconds, base, scale, factors, engine = job
     # a worker keeps the last run it loaded, until that run's metrics.json changes
     key = (str(run_dir), RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
@@ -88,9 +88,9 @@ def _one(job) -> dict:
     steps = round(seconds / ref.dt)
     q_ref = ref.trajectory(scale, seconds)
     if mode == "learned":
-        ro = run(MujocoPlant(robot, opts), lg.policy(robot, scale), steps)
+        ro = run(make_plant(robot, opts, engine), lg.policy(robot, scale), steps)
     else:
-        ro = playback(MujocoPlant(robot, opts), q_ref, q0=q_ref[0])
+        ro = playback(make_plant(robot, opts, engine), q_ref, q0=q_ref[0])
     m = walk_metrics(ro, ref.expected_distance(scale, ro.seconds), q_ref)
     out = m.to_dict()
     out["seed"] = seed
@@ -108,11 +108,13 @@ def per_seed(
     modes=("learned", "open_loop"),
     scale=None,
     factors: tuple[str, ...] = FACTORS,
+    engine: str = "mujoco",
 ) -> dict[str, list[dict]]:
     """Per-seed metrics of each mode (``factors``: what the perturbed robots differ in,
-    see :func:`imitwalk.perturb.perturbed`)."""
+    see :func:`imitwalk.perturb.perturbed`; ``engine``: one of
+    :data:`imitwalk.sim.ENGINES`)."""
     jobs = [
-        (str(run_dir), robot, mode, s, seconds, base, scale, tuple(factors))
+        (str(run_dir), robot, mode, s, seconds, base, scale, tuple(factors), engine)
         for mode in modes
         for s in seeds
     ]
@@ -186,13 +188,18 @@ def evaluate_run(
     workers=None,
     base: SimOptions | None = None,
     scale: float | None = None,
+    engine: str = "mujoco",
 ) -> dict:
     """``{"learned": ..., "open_loop": ...}`` with the same keys (per-seed figures as
     ``{"mean", "min", "max"}``); open loop is the reference at the same scale.
     ``"comparison"`` holds the paired fall comparison (:func:`compare_falls`).
-    ``scale``: judge both at this scale instead of the one the run reached."""
+    ``scale``: judge both at this scale instead of the one the run reached.
+    ``engine``: the physics engine both are judged on (:data:`imitwalk.sim.ENGINES`;
+    learning always ran on MuJoCo)."""
     metrics = RunDir(run_dir).read_json("metrics.json")
-    res = per_seed(run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale)
+    res = per_seed(
+        run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale, engine=engine
+    )
     out = {mode: _summary(runs, metrics) for mode, runs in res.items()}
     out["open_loop"]["sim_seconds_used_for_learning"] = 0.0
     out["open_loop"]["wall_seconds_for_learning"] = 0.0
@@ -204,5 +211,6 @@ def evaluate_run(
         "seconds": seconds,
         "seeds": seeds,
         "scale": scale or metrics.get("scale_reached"),
+        "engine": engine,
     }
     return out

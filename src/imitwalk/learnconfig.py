@@ -19,6 +19,7 @@ from typing import ClassVar
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.gait import GaitConfig
+from imitwalk.simtypes import ENGINES
 from imitwalk.stepconfig import StepConfig
 
 __all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
@@ -104,6 +105,8 @@ class LearnConfig:
             the gain kept, on the same robots; list the human's own rate, 1, first.
             Empty: the reference's cadence.
         seed: random seed; workers: parallel processes (``None``: one per core).
+        engine: the physics engine the robot learns on (:data:`imitwalk.simtypes.ENGINES`;
+            ``bullet`` is about ten times slower than MuJoCo).
     """
 
     variant: str = "extended"
@@ -121,8 +124,11 @@ class LearnConfig:
     gain_seconds: float = 24.0
     seed: int = 0
     workers: int | None = None
+    engine: str = "mujoco"
 
     def __post_init__(self):
+        if self.engine not in ENGINES:
+            raise unknown_name("engine", self.engine, ENGINES, ConfigError)
         for g in self.gains:  # each candidate must be a valid step.gain (its check)
             replace(self.step, gain=g)
         for r in self.cadences:

@@ -22,7 +22,7 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from imitwalk.config import to_dict
+from imitwalk.config import from_dict, to_dict
 from imitwalk.controller import stability_cost
 from imitwalk.errors import RunError
 from imitwalk.gait import GaitModel
@@ -43,14 +43,14 @@ def _episode(job) -> dict:
     """One training episode on one robot (runs in a worker process)."""
     from imitwalk.metrics import walk_metrics
     from imitwalk.perturb import perturbed
-    from imitwalk.sim import MujocoPlant, run
+    from imitwalk.sim import make_plant, run
 
     robot, gait, scale, cfg, models, seed, explore, rng_seed, seconds = job
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
     steps = round(seconds / ref.dt)
     opts = perturbed(seed, disturbance=seed != 0, friction_range=tuple(cfg.train_friction))
-    ro = run(MujocoPlant(robot, opts), policy, steps)
+    ro = run(make_plant(robot, opts, cfg.engine), policy, steps)
     m = walk_metrics(
         ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
     )
@@ -113,7 +113,8 @@ def learn(
         if not rd.exists("checkpoint.json"):
             raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
         state = rd.read_json("checkpoint.json")
-        if rd.read_json("config.json")["learn"] != cfg_json["learn"]:
+        saved = from_dict(LearnConfig, rd.read_json("config.json")["learn"])  # + new defaults
+        if to_dict(saved) != cfg_json["learn"]:
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
         log = rd.read_log()
         data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else {}

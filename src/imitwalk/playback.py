@@ -16,7 +16,7 @@ from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
-from imitwalk.sim import MujocoPlant, SimOptions, playback
+from imitwalk.sim import SimOptions, make_plant, playback
 
 __all__ = ["ModelRun", "play_reference", "summary", "walked"]
 
@@ -40,8 +40,8 @@ class ModelRun:
 
 
 def _one(args) -> ModelRun:
-    robot, q, q0, options, expected_fn, seed = args
-    plant = MujocoPlant(robot, options)
+    robot, q, q0, options, expected_fn, seed, engine = args
+    plant = make_plant(robot, options, engine)
     ro = playback(plant, q, q0=q0)
     m = walk_metrics(ro, expected_fn(ro.seconds), q_ref=q)
     return ModelRun(seed, m, walked(m))
@@ -63,6 +63,7 @@ def play_reference(
     seeds: tuple[int, ...] | list[int] = (0,),
     base: SimOptions | None = None,
     workers: int | None = None,
+    engine: str = "mujoco",
 ) -> list[ModelRun]:
     """Play ``ref`` at ``scale`` open loop for ``seconds`` on the robots ``seeds``.
 
@@ -72,9 +73,10 @@ def play_reference(
         seeds: 0 is the nominal robot, others perturbed (see :mod:`imitwalk.perturb`).
         base: options every run starts from (rates, noise, slope ...).
         workers: parallel processes (default: one per core; 1 runs in this process).
+        engine: physics engine, one of :data:`imitwalk.sim.ENGINES`.
     """
     q = ref.trajectory(scale, seconds)
-    jobs = [(robot, q, q[0], perturbed(s, base), _Expected(ref, scale), s) for s in seeds]
+    jobs = [(robot, q, q[0], perturbed(s, base), _Expected(ref, scale), s, engine) for s in seeds]
     return run_parallel(_one, jobs, workers)
 
 

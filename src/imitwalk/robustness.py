@@ -59,9 +59,10 @@ def robustness_grid(
     progress=None,
     cells: tuple[str, ...] | None = None,
     scale: float | None = None,
+    engine: str = "mujoco",
 ) -> dict:
     """Survival and distance per cell, learned vs open loop (at ``scale``, default the
-    scale the run reached).
+    scale the run reached), on ``engine`` (:data:`imitwalk.sim.ENGINES`).
 
     Returns:
         ``{"cells": {name: {"learned": {...}, "open_loop": {...}}}, "totals": {...}}`` where
@@ -70,10 +71,17 @@ def robustness_grid(
     """
     grid = _cells(seconds)
     names = cells or tuple(grid)
-    out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "cells": {}}
+    out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine, "cells": {}}
     for name in names:
         res = per_seed(
-            run_dir, robot, seconds, list(range(seeds)), grid[name], workers, scale=scale
+            run_dir,
+            robot,
+            seconds,
+            list(range(seeds)),
+            grid[name],
+            workers,
+            scale=scale,
+            engine=engine,
         )
         row = {}
         for mode, runs in res.items():

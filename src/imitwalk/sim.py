@@ -22,11 +22,28 @@ from typing import Protocol, runtime_checkable
 import mujoco
 import numpy as np
 
-from imitwalk.errors import unknown_name
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.robots import Robot
-from imitwalk.simtypes import Observation, Rollout, SimOptions
+from imitwalk.simtypes import (
+    ENGINES,
+    Observation,
+    Rollout,
+    SimOptions,
+    checked_targets,
+    jitter_draws,
+)
 
-__all__ = ["MujocoPlant", "Observation", "Plant", "Rollout", "SimOptions", "playback", "run"]
+__all__ = [
+    "ENGINES",
+    "MujocoPlant",
+    "Observation",
+    "Plant",
+    "Rollout",
+    "SimOptions",
+    "make_plant",
+    "playback",
+    "run",
+]
 
 
 @runtime_checkable
@@ -58,28 +75,19 @@ class MujocoPlant:
         self.joint_names = robot.joint_names
         self.control_dt = opt.substeps / opt.physics_hz
         self.model = m = robot.compile()
-        rng = np.random.default_rng(opt.seed)
+        scale, kps = jitter_draws(opt, m.nbody, robot.joint_names)
         m.opt.timestep = 1.0 / opt.physics_hz
         th = np.deg2rad(opt.slope_deg)
         m.opt.gravity[:] = 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
         if opt.friction is not None:
             m.geom_friction[:, 0] = opt.friction
         m.geom_friction[:, 0] *= opt.friction_scale
-        scale = opt.mass_scale * rng.uniform(1 - opt.mass_jitter, 1 + opt.mass_jitter, m.nbody)
-        scale[0] = 1.0
         m.body_mass[:] *= scale
         m.body_inertia[:] *= scale[:, None]
         self._jid = np.array([m.joint(j).id for j in robot.mj_joints])
         self._qadr = m.jnt_qposadr[self._jid]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
         self._act = np.array([act_for[j] for j in self._jid])
-        jitter = rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(self._act))
-        if opt.kp_jitter_joints:
-            for j in opt.kp_jitter_joints:
-                if j not in robot.joint_names:
-                    raise unknown_name("joint", j, robot.joint_names)
-            jitter[[j not in opt.kp_jitter_joints for j in robot.joint_names]] = 1.0
-        kps = opt.kp_scale * jitter
         m.actuator_gainprm[self._act, 0] *= kps
         m.actuator_biasprm[self._act, 1] *= kps
         self._sign = robot.signs
@@ -119,10 +127,7 @@ class MujocoPlant:
         return self.observe()
 
     def command(self, targets: np.ndarray) -> None:
-        targets = np.asarray(targets, dtype=float)
-        if targets.shape != (len(self.joint_names),):
-            raise ValueError(f"expected {len(self.joint_names)} joint targets, got {targets.shape}")
-        self._cmd = self.robot.clip(targets)
+        self._cmd = self.robot.clip(checked_targets(targets, len(self.joint_names)))
 
     def step(self) -> Observation:
         m, d, opt = self.model, self.data, self.options
@@ -137,7 +142,21 @@ class MujocoPlant:
         self._check_fall()
         return self.observe()
 
-    # -- extras (not part of Plant) -------------------------------------------
+    # -- extras (not part of Plant; BulletPlant has them too) -----------------
+    @property
+    def nq(self) -> int:
+        """Length of the MuJoCo ``qpos``."""
+        return self.model.nq
+
+    @property
+    def commanded(self) -> np.ndarray:
+        """``(n,)`` the joint targets [rad] last commanded (clipped, before any delay)."""
+        return self._cmd
+
+    def qpos(self) -> np.ndarray:
+        """A copy of the MuJoCo ``qpos`` now (free base, then joints)."""
+        return self.data.qpos.copy()
+
     def observe(self) -> Observation:
         """Sensor readings now, with the configured noise."""
         d, opt = self.data, self.options
@@ -178,11 +197,26 @@ class MujocoPlant:
             self.fell, self.fall_time = True, float(d.time)
 
 
+def make_plant(robot: Robot, options: SimOptions | None = None, engine: str = "mujoco"):
+    """A plant of ``robot`` on ``engine`` (one of :data:`ENGINES`).
+
+    Raises:
+        ConfigError: an unknown engine (the message lists the valid ones).
+    """
+    if engine == "mujoco":
+        return MujocoPlant(robot, options)
+    if engine == "bullet":
+        from imitwalk.bullet import BulletPlant
+
+        return BulletPlant(robot, options)
+    raise unknown_name("engine", engine, ENGINES, ConfigError)
+
+
 Policy = Callable[[int, Observation], np.ndarray]
 
 
 def run(
-    plant: MujocoPlant,
+    plant: Plant,
     policy: Policy,
     steps: int,
     q0: np.ndarray | None = None,
@@ -191,7 +225,9 @@ def run(
     """Run ``policy(tick, obs) -> (n,) targets`` for ``steps`` control periods.
 
     Args:
-        plant: the simulated robot (reset here to ``q0``).
+        plant: the simulated robot (reset here to ``q0``): a :class:`MujocoPlant` or an
+            :class:`imitwalk.bullet.BulletPlant` (``run`` also reads their ground-truth
+            extras: ``nq``, ``commanded``, ``qpos()``, ``torques()``, ``torso_pose()``).
         policy: called once per tick with the tick index and the latest observation.
         steps: number of control periods to run.
         q0: ``(n,)`` starting posture [rad]; ``None``: the policy's own ``q0`` if it
@@ -202,7 +238,7 @@ def run(
     if q0 is None:
         q0 = getattr(policy, "q0", None)
     obs = plant.reset(q0)
-    n, nq = len(plant.joint_names), plant.model.nq
+    n, nq = len(plant.joint_names), plant.nq
     keys = ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos", "torque")
     rec = {k: [] for k in keys}
     for k in range(steps):
@@ -214,14 +250,14 @@ def run(
             rec,
             (
                 obs.t,
-                plant._cmd,
+                plant.commanded,
                 obs.joints,
                 obs.gyro,
                 obs.accel,
                 obs.foot_force,
                 pos,
                 quat,
-                plant.data.qpos.copy(),
+                plant.qpos(),
                 plant.torques(),
             ),
             strict=True,
@@ -251,7 +287,7 @@ def run(
 
 
 def playback(
-    plant: MujocoPlant,
+    plant: Plant,
     targets: np.ndarray,
     q0: np.ndarray | None = None,
     stop_on_fall: bool = True,

@@ -9,7 +9,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Observation", "Rollout", "SimOptions"]
+__all__ = [
+    "ENGINES",
+    "Observation",
+    "Rollout",
+    "SimOptions",
+    "checked_targets",
+    "jitter_draws",
+]
+
+#: Physics engines a plant can run on: MuJoCo (learning always runs there) and
+#: Bullet (:class:`imitwalk.bullet.BulletPlant`, for judging transfer).
+ENGINES = ("mujoco", "bullet")
 
 
 @dataclass(frozen=True)
@@ -63,6 +74,48 @@ class SimOptions:
     def substeps(self) -> int:
         """Physics steps per control period."""
         return max(1, round(self.physics_hz / self.control_hz))
+
+
+def checked_targets(targets, n: int) -> np.ndarray:
+    """``targets`` as a ``(n,)`` float array of joint targets [rad].
+
+    Raises:
+        ValueError: any other shape.
+    """
+    targets = np.asarray(targets, dtype=float)
+    if targets.shape != (n,):
+        raise ValueError(f"expected {n} joint targets, got {targets.shape}")
+    return targets
+
+
+def jitter_draws(
+    options: SimOptions, nbody: int, joint_names: tuple[str, ...]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The per-body mass and per-servo stiffness factors of a perturbed robot.
+
+    Every engine draws them here, in this order, from ``options.seed``, so a seed is the
+    same robot on MuJoCo and on Bullet.
+
+    Returns:
+        ``(nbody,)`` mass (and inertia) factors, the world's (body 0) 1; ``(n,)`` servo
+        stiffness factors, in the order of ``joint_names``.
+
+    Raises:
+        RobotError: a name in ``options.kp_jitter_joints`` that is not a joint.
+    """
+    from imitwalk.errors import unknown_name
+
+    opt = options
+    rng = np.random.default_rng(opt.seed)
+    mass = opt.mass_scale * rng.uniform(1 - opt.mass_jitter, 1 + opt.mass_jitter, nbody)
+    mass[0] = 1.0
+    kp = rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(joint_names))
+    if opt.kp_jitter_joints:
+        for j in opt.kp_jitter_joints:
+            if j not in joint_names:
+                raise unknown_name("joint", j, joint_names)
+        kp[[j not in opt.kp_jitter_joints for j in joint_names]] = 1.0
+    return mass, opt.kp_scale * kp
 
 
 @dataclass(frozen=True)

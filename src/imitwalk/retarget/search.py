@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed, train_seeds
@@ -23,7 +24,8 @@ from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
-from imitwalk.sim import MujocoPlant, SimOptions, playback
+from imitwalk.sim import SimOptions, make_plant, playback
+from imitwalk.simtypes import ENGINES
 
 __all__ = ["BOUNDS", "SearchConfig", "search_params"]
 
@@ -50,6 +52,7 @@ class SearchConfig:
             on 2 of 6 robots at scale 0.5; 4 doubles the search's cost and fixed that.
         seconds: simulated time per rollout [s]; seed: the search's random seed.
         workers: parallel processes (``None``: one per core).
+        engine: the physics engine of the trials (:data:`imitwalk.simtypes.ENGINES`).
     """
 
     generations: int = 5
@@ -60,6 +63,11 @@ class SearchConfig:
     seconds: float = 12.0
     seed: int = 0
     workers: int | None = None
+    engine: str = "mujoco"
+
+    def __post_init__(self):
+        if self.engine not in ENGINES:
+            raise unknown_name("engine", self.engine, ENGINES, ConfigError)
 
 
 _IK: dict = {}
@@ -74,7 +82,7 @@ def _trial(job) -> dict:
     for s in cfg.scales:
         q = ref.trajectory(s, cfg.seconds)
         for seed in train_seeds(cfg.models):
-            ro = playback(MujocoPlant(robot, perturbed(seed, base)), q, q0=q[0])
+            ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
             m = walk_metrics(ro, ref.expected_distance(s, ro.seconds))
             val = (
                 ro.seconds / cfg.seconds
