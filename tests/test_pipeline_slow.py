@@ -53,3 +53,19 @@ def test_demo_writes_a_report(tmp_path, capsys):
         assert part in page, part
     assert (out / "before_after.mp4").stat().st_size > 10_000
     assert (out / "filmstrip.png").is_file()
+
+
+@pytest.mark.slow
+def test_learn_and_evaluate_on_bullet(tmp_path, capsys):
+    """The whole method on the second engine: search, learn and judge on Bullet."""
+    out = tmp_path / "run"
+    argv = ["learn", "--out", str(out), "--json", "--set", "engine=bullet"]
+    argv += ["--set", "retarget.search_config.engine=bullet"]
+    argv += [a for s in QUICK for a in ("--set", s)]
+    assert main(argv) == 0
+    learned = json.loads(capsys.readouterr().out)
+    assert learned["iterations"] >= 2
+    assert main(["evaluate", str(out), "--seconds", "10", "--seeds", "2", "--json"]) == 0
+    ev = json.loads(capsys.readouterr().out)
+    assert ev["settings"]["engine"] == "bullet"  # the engine the run learned on
+    assert (out / "evaluation.json").is_file() and ev["learned"]["seeds"] == 2

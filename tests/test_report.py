@@ -48,12 +48,14 @@ FIGURES = {
 
 @pytest.fixture(scope="module")
 def run_dir(robot, tiny_reference, tmp_path_factory):
-    """A tiny faithful run, evaluated (2 seeds × 6 s), with a two-cell robustness grid."""
+    """A tiny faithful run, evaluated (2 seeds × 6 s) on both engines, with a two-cell
+    robustness grid."""
     ref, _ = tiny_reference
     out = tmp_path_factory.mktemp("report") / "run"
     learn(ref, robot, apply_overrides(preset("faithful"), TINY), out)
     argv = ["evaluate", str(out), "--seconds", "6", "--seeds", "2", "--workers", "1", "--json"]
     assert main(argv) == 0
+    assert main([*argv, "--engine", "bullet"]) == 0  # writes evaluation_bullet.json
     grid = robustness_grid(
         out, robot, seconds=2.0, seeds=1, workers=1, cells=("nominal", "push_small")
     )
@@ -76,7 +78,7 @@ def bare_report(run_dir, robot, tmp_path_factory):
         run_dir,
         bare,
         ignore=shutil.ignore_patterns(
-            "evaluation.json", "robustness.json", "report.html", "*.mp4", "*.png"
+            "evaluation*.json", "robustness.json", "report.html", "*.mp4", "*.png"
         ),
     )
     ref = Reference.load(bare / "reference.npz")
@@ -95,7 +97,7 @@ def test_report_is_self_contained(report):
     assert "<script" not in text.lower()
     assert text.count("data:image/png;base64,") == len(FIGURES)
     assert text.count("data:video/mp4;base64,") == 1
-    for needed in ("forward_distance_m", "push_small", "<details>", "Fig. 8"):
+    for needed in ("forward_distance_m", "push_small", "<details>", "Fig. 8", "evaluation_bullet"):
         assert needed in text, needed
     mp4 = path.with_name("before_after.mp4").read_bytes()
     assert mp4[4:8] == b"ftyp" and b"avc1" in mp4  # an H.264 MP4

@@ -206,7 +206,8 @@ def evaluate(args: argparse.Namespace) -> int:
     cfg = rd.read_json("config.json")
     ref_settings = cfg.get("reference", {})
     args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
-    args.engine = args.engine or cfg.get("learn", {}).get("engine", "mujoco")
+    learned_on = cfg.get("learn", {}).get("engine", "mujoco")
+    args.engine = args.engine or learned_on
     robot = robot_from(args)
     if args.perturb:
         progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
@@ -220,7 +221,7 @@ def evaluate(args: argparse.Namespace) -> int:
             scale=args.scale,
             engine=args.engine,
         )
-        name = _result_name("robustness", args)
+        name = _result_name("robustness", args, learned_on)
         rd.write_json(name, out)
     else:
         progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
@@ -233,16 +234,17 @@ def evaluate(args: argparse.Namespace) -> int:
             scale=args.scale,
             engine=args.engine,
         )
-        name = _result_name("evaluation", args)
+        name = _result_name("evaluation", args, learned_on)
         rd.write_json(name, out)
     emit(out, args.json)
     return 0
 
 
-def _result_name(kind: str, args: argparse.Namespace) -> str:
-    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_bullet.json`` ..."""
+def _result_name(kind: str, args: argparse.Namespace, learned_on: str) -> str:
+    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_bullet.json`` (on
+    another engine than the run learned on) ..."""
     scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    engine = "" if args.engine == "mujoco" else f"_{args.engine}"
+    engine = "" if args.engine == learned_on else f"_{args.engine}"
     return f"{kind}{scale}{engine}.json"
 
 

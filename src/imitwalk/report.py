@@ -47,7 +47,7 @@ def _fmt(v) -> str:
     return html.escape(str(v))
 
 
-def _metrics_table(ev: dict) -> str:
+def _metrics_table(ev: dict, source: str = "evaluation.json") -> str:
     learned, open_loop = ev.get("learned", {}), ev.get("open_loop", {})
     rows = []
     for k in learned:
@@ -60,7 +60,7 @@ def _metrics_table(ev: dict) -> str:
     st = ev.get("settings", {})
     note = ", ".join(f"{html.escape(str(k))} = {html.escape(str(v))}" for k, v in st.items())
     return (
-        f"<p>From <code>evaluation.json</code> ({note}); per-seed values are "
+        f"<p>From <code>{html.escape(source)}</code> ({note}); per-seed values are "
         "mean (min … max).</p><table><tr><th></th><th>learned</th><th>open loop</th></tr>"
         + "".join(rows)
         + "</table>"
@@ -199,6 +199,9 @@ def _sections(
             '<p class="missing">No <code>evaluation.json</code>: run '
             "<code>imitwalk evaluate RUN</code>.</p>"
         )
+    for other in ("evaluation_bullet.json", "evaluation_mujoco.json"):  # the other engine
+        if rd.exists(other):
+            evaluation += _metrics_table(rd.read_json(other), other)
     gyro = curves.gyro_traces(
         media.gyro_until_fall(rp.before),
         media.gyro_until_fall(rp.after),
