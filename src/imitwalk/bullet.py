@@ -3,7 +3,8 @@
 :class:`BulletPlant` implements :class:`imitwalk.sim.Plant` on Bullet (the ``pybullet``
 wheel, already a dependency for the default clip), so a reference or a controller
 learned on MuJoCo can be played, unchanged, on another engine's contact model and
-integrator: ``imitwalk evaluate RUN --engine bullet``. Learning never sees Bullet.
+integrator (``imitwalk evaluate RUN --engine bullet``), and the whole method can be run
+on it (``imitwalk learn --set engine=bullet --set retarget.search_config.engine=bullet``).
 
 The robot is the MuJoCo model written out as URDF (:func:`imitwalk.robots.urdf.to_urdf`):
 the same masses, inertias, joint axes, ranges and collision shapes. The servos are the
@@ -86,11 +87,12 @@ class BulletPlant:
         scale, kps = jitter_draws(opt, m.nbody, robot.joint_names)  # as MujocoPlant's
         for b in range(1, m.nbody):
             mu = opt.friction if opt.friction is not None else u.friction[b]
+            mass, inertia = m.body_mass[b] * scale[b], m.body_inertia[b] * scale[b]
             pb.changeDynamics(
                 self.body,
                 self._link_of_body[b],
-                mass=float(m.body_mass[b] * scale[b]),
-                localInertiaDiagonal=(m.body_inertia[b] * scale[b]).tolist(),
+                mass=max(float(mass), 1e-6),  # as the URDF's
+                localInertiaDiagonal=inertia.tolist(),
                 lateralFriction=float(mu * opt.friction_scale),
                 physicsClientId=c,
             )
@@ -110,6 +112,10 @@ class BulletPlant:
         self._stand_qpos = robot.stand_qpos.copy()
 
         def site(name: str, sensor: bool = True):
+            """(link, position in it, half-size) of a sensor's site, or of a sole (a site,
+            else a body's origin)."""
+            if not sensor and name not in [m.site(i).name for i in range(m.nsite)]:
+                return self._link_of_body[m.body(name).id], np.zeros(3), np.zeros(3)
             sid = m.sensor(name).objid[0] if sensor else m.site(name).id
             link = self._link_of_body[m.site_bodyid[sid]]
             return link, m.site_pos[sid].copy(), m.site_size[sid].copy()
@@ -124,7 +130,7 @@ class BulletPlant:
         self._cmd = robot.stand.copy()
         self._applied = self._cmd.copy()
         self._tau = np.zeros(len(self._dof))
-        self._qd = np.zeros(len(self._dof))
+        self._qd, self._other = np.zeros(len(self._dof)), np.zeros(len(self._dof))
         self._v_imu = np.zeros(3)
         self._accel = np.zeros(3)
         self.time = 0.0
@@ -208,41 +214,32 @@ class BulletPlant:
 
     def step(self) -> Observation:
         c, opt = self.client, self.options
+        cid = {"physicsClientId": c}
         self._queue.append(self._cmd)
         self._applied = self._queue.popleft()
         target = self._applied * self._sign
         dt, kp, kd = self.dt, self.kp, self.kd
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
         mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
+        mjj = mass[6 + np.array(self._dof)]  # each joint's own inertia [kg m²]
         damp = kp * dt + kd
-        ratio = damp * dt / mass[6 + np.array(self._dof)]
+        ratio = damp * dt / mjj
         for _ in range(self.substeps):
             states = pb.getJointStates(self.body, self._dof, physicsClientId=c)
             q = np.array([s[0] for s in states])
             qd = np.array([s[1] for s in states])
             # the other torques on each joint over the last step (gravity, contacts, ...)
-            now = (qd - self._qd) / dt * mass[6 + np.array(self._dof)] - self._tau
+            now = (qd - self._qd) / dt * mjj - self._tau
             self._other = other = self._other + SMOOTH * (now - self._other)
             tau = (kp * (target - q) - damp * qd - ratio * other) / (1.0 + ratio)
             self._tau, self._qd = np.clip(tau, -self.limit, self.limit), qd
-            pb.setJointMotorControlArray(
-                self.body,
-                self._dof,
-                pb.TORQUE_CONTROL,
-                forces=self._tau.tolist(),
-                physicsClientId=c,
-            )
+            tau = self._tau.tolist()
+            pb.setJointMotorControlArray(self.body, self._dof, pb.TORQUE_CONTROL, forces=tau, **cid)
             t0 = opt.push_time
             if opt.push_duration > 0 and t0 <= self.time < t0 + opt.push_duration:
-                com = pb.getLinkState(self.body, self._torso, physicsClientId=c)[0]
-                pb.applyExternalForce(
-                    self.body,
-                    self._torso,
-                    list(opt.push_force),
-                    com,
-                    pb.WORLD_FRAME,
-                    physicsClientId=c,
-                )
+                com = pb.getLinkState(self.body, self._torso, **cid)[0]
+                force = list(opt.push_force)  # at the torso's centre of mass, as MuJoCo's
+                pb.applyExternalForce(self.body, self._torso, force, com, pb.WORLD_FRAME, **cid)
             pb.stepSimulation(physicsClientId=c)
             self.time += self.dt
         v = self._site_velocity(self._imu[0], self._imu[1])[0]

@@ -194,8 +194,8 @@ def evaluate_run(
     ``{"mean", "min", "max"}``); open loop is the reference at the same scale.
     ``"comparison"`` holds the paired fall comparison (:func:`compare_falls`).
     ``scale``: judge both at this scale instead of the one the run reached.
-    ``engine``: the physics engine both are judged on (:data:`imitwalk.sim.ENGINES`;
-    learning always ran on MuJoCo)."""
+    ``engine``: the physics engine both are judged on (:data:`imitwalk.sim.ENGINES`),
+    whichever the run learned on."""
     metrics = RunDir(run_dir).read_json("metrics.json")
     res = per_seed(
         run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale, engine=engine

@@ -17,7 +17,7 @@ import numpy as np
 from imitwalk import plots
 from imitwalk.retarget.reference import atomic_write
 from imitwalk.robots import Robot
-from imitwalk.sim import MujocoPlant, Rollout, SimOptions, playback, run
+from imitwalk.sim import MujocoPlant, Rollout, SimOptions, make_plant, playback, run
 from imitwalk.trust import LABELS
 
 __all__ = [
@@ -183,13 +183,15 @@ class Replays:
 def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Replays:
     """Run the open-loop reference and the learned controller of a loaded run
     (:func:`~imitwalk.evaluate.load_gait`) for ``seconds`` [s] at ``scale`` (default:
-    the scale reached), without stopping at a fall; they start as in
-    :mod:`imitwalk.evaluate`."""
+    the scale reached) on the engine it learned on, without stopping at a fall; they
+    start as in :mod:`imitwalk.evaluate`."""
     scale = lg.scale if scale is None else scale
     q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
-    before = playback(MujocoPlant(robot, SimOptions()), q_ref, q0=q_ref[0], stop_on_fall=False)
+    engine = lg.config.engine  # the run's own engine; the video is drawn by MuJoCo
+    plant = make_plant(robot, SimOptions(), engine)
+    before = playback(plant, q_ref, q0=q_ref[0], stop_on_fall=False)
     policy = lg.policy(robot, scale)
-    after = run(MujocoPlant(robot, SimOptions()), policy, len(q_ref), stop_on_fall=False)
+    after = run(make_plant(robot, SimOptions(), engine), policy, len(q_ref), stop_on_fall=False)
     actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
     if after.fell:
         first = policy.first_loop_tick

@@ -18,8 +18,8 @@ __all__ = [
     "jitter_draws",
 ]
 
-#: Physics engines a plant can run on: MuJoCo (learning always runs there) and
-#: Bullet (:class:`imitwalk.bullet.BulletPlant`, for judging transfer).
+#: Physics engines a plant can run on: MuJoCo (the default everywhere) and Bullet
+#: (:class:`imitwalk.bullet.BulletPlant`, to judge transfer or to learn on another engine).
 ENGINES = ("mujoco", "bullet")
 
 
