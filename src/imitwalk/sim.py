@@ -1,4 +1,4 @@
-"""The simulator layer: the only module that steps physics.
+"""The simulator layer: the MuJoCo plant (with `imitwalk.bullet`, the only code that steps physics).
 
 :class:`Plant` is the interface a real robot driver could also implement: reset to
 a posture, command joint targets, step one control period, read an
