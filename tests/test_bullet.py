@@ -17,7 +17,7 @@ from imitwalk.errors import ConfigError, RobotError
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.perturb import perturbed
 from imitwalk.retarget.search import SearchConfig
-from imitwalk.robots import BUILTIN
+from imitwalk.robots import BUILTIN, load_robot
 from imitwalk.robots.urdf import to_urdf, urdf_file
 from imitwalk.sim import MujocoPlant, make_plant, playback, run
 from imitwalk.simtypes import jitter_draws
@@ -131,3 +131,14 @@ def test_engine_settings_are_checked():
     with pytest.raises(ConfigError, match="valid: bullet, mujoco"):
         SearchConfig(engine="physx")
     assert LearnConfig(engine="bullet").engine == "bullet"
+
+
+def test_servos_without_a_force_limit(tmp_path):
+    """An MJCF whose servos have no force range gets unlimited Bullet servos (not zero)."""
+    xml = (BUILTIN["hoap2"].parent / "hoap2.xml").read_text().replace(' forcerange="-4 4"', "")
+    (tmp_path / "free.xml").write_text(xml)
+    bot = load_robot(tmp_path / "free.xml", BUILTIN["hoap2"])
+    plant = BulletPlant(bot)
+    legs = [bot.index(j) for j in ("l_knee", "r_knee", "l_hip_pitch")]
+    assert np.all(np.isinf(plant.torque_limits()[legs]))
+    assert not run(plant, lambda k, obs: bot.stand, 100).fell

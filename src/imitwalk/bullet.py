@@ -69,8 +69,8 @@ class BulletPlant:
         self.nq = m.nq
         self.client = c = pb.connect(pb.DIRECT)
         th = np.deg2rad(opt.slope_deg)
-        pb.setGravity(-9.81 * np.sin(th), 0.0, -9.81 * np.cos(th), physicsClientId=c)
-        self.gravity = np.array([-9.81 * np.sin(th), 0.0, -9.81 * np.cos(th)])
+        self.gravity = 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+        pb.setGravity(*self.gravity, physicsClientId=c)
         pb.setTimeStep(self.dt, physicsClientId=c)
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
         self.floor = pb.createMultiBody(0, plane, physicsClientId=c)
@@ -104,10 +104,9 @@ class BulletPlant:
         self._dof = [joint[j] for j in robot.mj_joints]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
         act = np.array([act_for[j] for j in jid])
-        dof = m.jnt_dofadr[jid]
-        self.kp = m.actuator_gainprm[act, 0] * kps
-        self.kd = -m.actuator_biasprm[act, 2] + m.dof_damping[dof]
-        self.limit = np.abs(m.actuator_forcerange[act]).max(axis=1)
+        self.kp = robot.kp * kps
+        self.kd = -m.actuator_biasprm[act, 2] + m.dof_damping[m.jnt_dofadr[jid]]
+        self.limit = robot.torque_limit
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
@@ -128,11 +127,10 @@ class BulletPlant:
         self._noise = np.random.default_rng(opt.seed + 7919)
         self._queue: deque[np.ndarray] = deque()
         self._cmd = robot.stand.copy()
-        self._applied = self._cmd.copy()
         self._tau = np.zeros(len(self._dof))
         self._qd, self._other = np.zeros(len(self._dof)), np.zeros(len(self._dof))
-        self._v_imu = np.zeros(3)
         self._accel = np.zeros(3)
+        self._imu_now = (np.zeros(3), np.zeros(3), np.eye(3))  # set by reset() and step()
         self.time = 0.0
         self.fell = False
         self.fall_time: float | None = None
@@ -199,9 +197,8 @@ class BulletPlant:
         lin, ang = tw[:3].tolist(), (_rot(orn) @ tw[3:]).tolist()
         pb.resetBaseVelocity(self.body, lin, ang, physicsClientId=c)
         self._cmd = q.copy()
-        self._applied = q.copy()
         self._queue = deque([self._cmd.copy()] * opt.servo_delay)
-        self._v_imu = self._site_velocity(self._imu[0], self._imu[1])[0]
+        self._imu_now = self._site_velocity(*self._imu[:2])  # (v, ω, R) of the IMU site
         self._accel = np.zeros(3)
         self._tau, self._qd = np.zeros(len(self._dof)), np.zeros(len(self._dof))
         self._other = np.zeros(len(self._dof))
@@ -216,8 +213,7 @@ class BulletPlant:
         c, opt = self.client, self.options
         cid = {"physicsClientId": c}
         self._queue.append(self._cmd)
-        self._applied = self._queue.popleft()
-        target = self._applied * self._sign
+        target = self._queue.popleft() * self._sign
         dt, kp, kd = self.dt, self.kp, self.kd
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
         mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
@@ -242,8 +238,8 @@ class BulletPlant:
                 pb.applyExternalForce(self.body, self._torso, force, com, pb.WORLD_FRAME, **cid)
             pb.stepSimulation(physicsClientId=c)
             self.time += self.dt
-        v = self._site_velocity(self._imu[0], self._imu[1])[0]
-        self._accel, self._v_imu = (v - self._v_imu) / self.control_dt, v
+        v_before, self._imu_now = self._imu_now[0], self._site_velocity(*self._imu[:2])
+        self._accel = (self._imu_now[0] - v_before) / self.control_dt
         self._check_fall()
         return self.observe()
 
@@ -251,7 +247,7 @@ class BulletPlant:
     def observe(self) -> Observation:
         """Sensor readings now, with the configured noise."""
         opt = self.options
-        _, w, rot = self._site_velocity(self._imu[0], self._imu[1])
+        _, w, rot = self._imu_now
         gyro = rot.T @ w
         accel = rot.T @ (self._accel - self.gravity)
         if opt.gyro_noise:
