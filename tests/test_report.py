@@ -38,6 +38,7 @@ FIGURES = {
     "film strip: robot after",
     "learning curves",
     "gyro traces",
+    "torso paths",
     "Fig. 3",
     "Fig. 4",
     "Fig. 6",
@@ -97,7 +98,14 @@ def test_report_is_self_contained(report):
     assert "<script" not in text.lower()
     assert text.count("data:image/png;base64,") == len(FIGURES)
     assert text.count("data:video/mp4;base64,") == 1
-    for needed in ("forward_distance_m", "push_small", "<details>", "Fig. 8", "evaluation_bullet"):
+    for needed in (
+        "forward_distance_m",
+        "push_small",
+        "<details>",
+        "Fig. 8",
+        "evaluation_bullet",
+        "straight ahead on level ground",
+    ):
         assert needed in text, needed
     mp4 = path.with_name("before_after.mp4").read_bytes()
     assert mp4[4:8] == b"ftyp" and b"avc1" in mp4  # an H.264 MP4

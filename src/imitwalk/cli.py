@@ -45,6 +45,20 @@ def _mocap_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--units", help="BVH length unit: m, cm, mm, inch, cmu (default: detect)")
 
 
+def _command_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("commanded gait (default: straight ahead on level ground)")
+    g.add_argument(
+        "--turn", type=float, metavar="DEG", help="turn per gait cycle at scale 1, + left"
+    )
+    g.add_argument(
+        "--side", type=float, metavar="M", help="sidestep per gait cycle at scale 1, + left"
+    )
+    g.add_argument(
+        "--forward", type=float, metavar="F", help="forward stride, a fraction of the human's (1)"
+    )
+    g.add_argument("--slope", type=float, metavar="DEG", help="ground slope to walk on, + uphill")
+
+
 def _settings(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--set",
@@ -88,6 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="skip the reference-parameter search (use the defaults or --set)",
     )
     _settings(rt)
+    _command_args(rt)
     rt.add_argument("--json", action="store_true", help="print JSON")
     rt.set_defaults(func=commands.retarget)
 
@@ -123,6 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="override a learning setting (e.g. schedule.stop=0.8), or a "
         "retargeting one with a retarget. prefix (repeatable)",
     )
+    _command_args(ln)
     ln.add_argument("--json", action="store_true", help="print JSON")
     ln.set_defaults(func=commands.learn)
 

@@ -106,7 +106,7 @@ def retarget(args: argparse.Namespace) -> int:
 
     robot = robot_from(args)
     cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
-    cfg = apply_overrides(cfg, args.set)
+    cfg = _with_command(apply_overrides(cfg, args.set), args)
     motion = _motion(args)
     progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
 
@@ -149,8 +149,18 @@ def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
     return rt, [i for i in items if not i.startswith("retarget.")]
 
 
+def _with_command(cfg, args: argparse.Namespace):
+    """``cfg`` (a RetargetConfig) with the ``--turn/--side/--forward/--slope`` flags given."""
+    from dataclasses import replace
+
+    flags = {"turn_deg": "turn", "side_m": "side", "forward": "forward", "slope_deg": "slope"}
+    given = {k: getattr(args, a) for k, a in flags.items() if getattr(args, a, None) is not None}
+    return replace(cfg, command=replace(cfg.command, **given)) if given else cfg
+
+
 def learn(args: argparse.Namespace) -> int:
     from imitwalk.config import apply_overrides
+    from imitwalk.errors import ConfigError
     from imitwalk.learnconfig import preset
     from imitwalk.learner import learn as run
     from imitwalk.retarget import Reference, RetargetConfig
@@ -161,6 +171,14 @@ def learn(args: argparse.Namespace) -> int:
     rt_set, learn_set = _split_settings(args.set)
     cfg = apply_overrides(preset(args.variant, seed=args.seed), learn_set)
     rd = RunDir(args.out)
+    flags = [
+        f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
+    ]
+    if flags and (args.reference or (args.resume and rd.exists("reference.npz"))):
+        raise ConfigError(
+            f"{', '.join(flags)} shape a new reference; a given or resumed reference keeps "
+            "the command it was built with (retarget again with them)"
+        )
     if args.resume and rd.exists("reference.npz"):
         ref = Reference.load(rd.file("reference.npz"))
         progress(f"learn: resuming {rd.path}")
@@ -169,7 +187,7 @@ def learn(args: argparse.Namespace) -> int:
     else:
         motion = _motion(args)
         progress(f"learn: retargeting {motion.source}")
-        rcfg = apply_overrides(RetargetConfig(), rt_set)
+        rcfg = _with_command(apply_overrides(RetargetConfig(), rt_set), args)
 
         def report(gen, total, score, params):
             progress(f"  reference search {gen}/{total}: best score {score:.3f}")

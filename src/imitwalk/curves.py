@@ -97,6 +97,29 @@ def gyro_traces(
     return fig
 
 
+def torso_paths(
+    runs: Sequence[tuple[str, np.ndarray]], commanded: np.ndarray | None = None
+) -> Figure:
+    """Top view of torso paths: ``runs`` of (label, ``(N, 3)`` positions [m]), each drawn
+    from its start, and the ``commanded`` ``(N, 2)`` walking-frame path [m] dashed."""
+    fig = _figure(6.0, 4.5)
+    ax = fig.add_subplot()
+    if commanded is not None and len(commanded):
+        c = np.asarray(commanded, dtype=float)
+        ax.plot(c[:, 0], c[:, 1], "k--", lw=1.0, label="commanded")
+    for (name, pos), color in zip(runs, ("tab:gray", "tab:green", "tab:blue"), strict=False):
+        p = np.asarray(pos, dtype=float).reshape(-1, 3)
+        if len(p):
+            ax.plot(p[:, 0] - p[0, 0], p[:, 1] - p[0, 1], color=color, lw=1.0, label=name)
+            ax.plot(p[-1, 0] - p[0, 0], p[-1, 1] - p[0, 1], "o", color=color, ms=4)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("Torso path, seen from above")
+    ax.legend(fontsize=7, loc="best")
+    return fig
+
+
 def robustness_heatmap(robustness: dict) -> Figure:
     """Survival per perturbation cell (rows) for the learned controller and open loop."""
     cells = robustness.get("cells", {})

@@ -83,15 +83,17 @@ def _one(job) -> dict:
         _CACHE[key] = load_gait(run_dir)
     lg = _CACHE[key]
     scale = lg.scale if scale is None else scale
-    opts = perturbed(seed, base, disturbance=seed != 0, factors=factors)
     ref = lg.gait.ref if mode == "learned" else lg.ref  # at the cadence each one plays
+    opts = perturbed(seed, ref.sim_options(base), disturbance=seed != 0, factors=factors)
     steps = round(seconds / ref.dt)
     q_ref = ref.trajectory(scale, seconds)
     if mode == "learned":
         ro = run(make_plant(robot, opts, engine), lg.policy(robot, scale), steps)
     else:
         ro = playback(make_plant(robot, opts, engine), q_ref, q0=q_ref[0])
-    m = walk_metrics(ro, ref.expected_distance(scale, ro.seconds), q_ref)
+    m = walk_metrics(
+        ro, ref.expected_distance(scale, ro.seconds), q_ref, ref.track(scale, ro.seconds)
+    )
     out = m.to_dict()
     out["seed"] = seed
     out["cycle_period_s"] = ref.period
@@ -139,9 +141,12 @@ def _summary(runs: list[dict], metrics: dict) -> dict:
                 "fall_time_s",
                 "progress_ratio",
                 "yaw_drift_deg",
+                "lateral_drift_m",
                 "forward_speed_mps",
                 "torque_saturation",
                 "saturated_joint",
+                "commanded_turn_deg",
+                "commanded_side_m",
             )
         }
         for r in runs

@@ -49,10 +49,15 @@ def _episode(job) -> dict:
     policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
     ref = gait.ref
     steps = round(seconds / ref.dt)
-    opts = perturbed(seed, disturbance=seed != 0, friction_range=tuple(cfg.train_friction))
+    opts = perturbed(
+        seed, ref.sim_options(), disturbance=seed != 0, friction_range=tuple(cfg.train_friction)
+    )
     ro = run(make_plant(robot, opts, cfg.engine), policy, steps)
     m = walk_metrics(
-        ro, ref.expected_distance(scale, ro.seconds), ref.trajectory(scale, ro.seconds)
+        ro,
+        ref.expected_distance(scale, ro.seconds),
+        ref.trajectory(scale, ro.seconds),
+        ref.track(scale, ro.seconds),
     )
     out = {"seed": seed, "metrics": m.to_dict(), "ticks": len(ro.t)}
     if policy.tick_states:

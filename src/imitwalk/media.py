@@ -64,9 +64,9 @@ def gyro_until_fall(ro: Rollout, margin: float = 0.3) -> np.ndarray:
 
 
 def outcome(ro: Rollout) -> str:
-    d = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
+    d = ro.torso_pos[-1, :2] - ro.torso_pos[0, :2] if len(ro.t) else np.zeros(2)
     fell = f"fell at {ro.fall_time:.2f} s" if ro.fell else "did not fall"
-    return f"{fell}; torso moved {d:+.2f} m along x in {ro.seconds:.1f} s"
+    return f"{fell}; torso moved {d[0]:+.2f} m along x, {d[1]:+.2f} m along y in {ro.seconds:.1f} s"
 
 
 def gain(metrics: dict) -> str:
@@ -188,10 +188,11 @@ def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Repl
     scale = lg.scale if scale is None else scale
     q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
     engine = lg.config.engine  # the run's own engine; the video is drawn by MuJoCo
-    plant = make_plant(robot, SimOptions(), engine)
+    opts = lg.ref.sim_options()  # on the ground the gait was built for
+    plant = make_plant(robot, opts, engine)
     before = playback(plant, q_ref, q0=q_ref[0], stop_on_fall=False)
     policy = lg.policy(robot, scale)
-    after = run(make_plant(robot, SimOptions(), engine), policy, len(q_ref), stop_on_fall=False)
+    after = run(make_plant(robot, opts, engine), policy, len(q_ref), stop_on_fall=False)
     actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
     if after.fell:
         first = policy.first_loop_tick

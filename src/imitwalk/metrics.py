@@ -35,17 +35,22 @@ class WalkMetrics:
     Attributes:
         fell: the torso fell; fall_time_s: when [s] (``None`` if it did not).
         seconds: simulated time [s].
-        forward_distance_m: torso travel along the initial heading [m].
+        forward_distance_m: torso travel along the initial heading [m] (along the
+            commanded heading of the moment, for a turning reference).
         forward_speed_mps: that distance over the time walked [m/s].
         progress_ratio: forward distance ÷ the distance the reference commands over
-            the same time (stride per cycle × cycles executed).
-        lateral_drift_m: sideways torso travel [m]; yaw_drift_deg: heading change [deg].
+            the same time (stride per cycle × cycles executed); for a reference that
+            steps on the spot, the turn (or else the sidestep) made ÷ the one commanded.
+        lateral_drift_m: sideways torso travel beyond the commanded sidestep [m];
+        yaw_drift_deg: heading change beyond the commanded turn [deg].
         gyro_rms: RMS of the torso angular velocity norm [rad/s].
         max_tilt_deg: largest torso tilt [deg].
         joint_rms_error_rad: RMS of measured minus reference joint angles [rad].
         torque_saturation: the largest, over the joints, fraction of ticks at which a
             servo gave at least 99 % of its torque limit (``None`` if not recorded);
             saturated_joint: that joint's name (``None`` if no servo saturated).
+        commanded_turn_deg, commanded_side_m: the turn [deg] and sidestep [m] the
+            reference commands over the run (0 for a straight walk).
     """
 
     fell: bool
@@ -61,13 +66,20 @@ class WalkMetrics:
     joint_rms_error_rad: float
     torque_saturation: float | None = None
     saturated_joint: str | None = None
+    commanded_turn_deg: float = 0.0
+    commanded_side_m: float = 0.0
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
         return asdict(self)
 
 
-def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = None) -> WalkMetrics:
+def walk_metrics(
+    rollout,
+    expected_distance: float,
+    q_ref: np.ndarray | None = None,
+    track: np.ndarray | None = None,
+) -> WalkMetrics:
     """Judge a rollout.
 
     Args:
@@ -76,17 +88,34 @@ def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = N
             duration [m] (the denominator of ``progress_ratio``).
         q_ref: ``(N, n)`` reference joint angles to compare the measured ones with;
             defaults to the commanded targets.
+        track: ``(T, 3)`` the commanded forward and sideways travel [m] and heading
+            [rad] per control tick (:meth:`~imitwalk.retarget.reference.Reference.track`);
+            ``None``: straight ahead. Distances are measured along the commanded
+            heading of each tick, and drifts are what is left beyond the command.
     """
     pos, quat = rollout.torso_pos, rollout.torso_quat
     if len(pos) == 0:
         raise ValueError("empty rollout")
     yaw = yaw_rad(quat)
     head = yaw[0]
-    d = pos[-1, :2] - pos[0, :2]
-    fwd = float(d[0] * np.cos(head) + d[1] * np.sin(head))
-    lat = float(-d[0] * np.sin(head) + d[1] * np.cos(head))
+    cmd = np.zeros((len(pos), 3))
+    if track is not None and len(track):
+        track = np.asarray(track, dtype=float)
+        cmd = track[np.minimum(np.arange(len(pos)), len(track) - 1)]
+    h = head + 0.5 * (cmd[1:, 2] + cmd[:-1, 2])  # (T-1,) commanded heading over each tick
+    d = np.diff(pos[:, :2], axis=0)
+    fwd = float(np.sum(d[:, 0] * np.cos(h) + d[:, 1] * np.sin(h)))
+    lat = float(np.sum(-d[:, 0] * np.sin(h) + d[:, 1] * np.cos(h)) - cmd[-1, 1])
     tail = max(1, int(round(1.0 / rollout.control_dt)))
-    yaw_drift = float(np.degrees(np.mean(yaw[-tail:]) - head))
+    yaw_drift = float(np.degrees(np.mean(yaw[-tail:] - cmd[-tail:, 2]) - head))
+    if expected_distance > 0:
+        progress = fwd / expected_distance
+    elif abs(cmd[-1, 2]) > 0:  # a turn on the spot: how much of the turn was made
+        progress = 1.0 + np.radians(yaw_drift) / cmd[-1, 2]
+    elif abs(cmd[-1, 1]) > 0:  # a sidestep on the spot
+        progress = 1.0 + lat / cmd[-1, 1]
+    else:
+        progress = 0.0
     seconds = rollout.seconds
     ref = rollout.q_cmd if q_ref is None else q_ref[: len(rollout.q)]
     err = rollout.q - ref
@@ -97,7 +126,7 @@ def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = N
         seconds=float(seconds),
         forward_distance_m=fwd,
         forward_speed_mps=fwd / seconds if seconds > 0 else 0.0,
-        progress_ratio=fwd / expected_distance if expected_distance > 0 else 0.0,
+        progress_ratio=float(progress),
         lateral_drift_m=lat,
         yaw_drift_deg=yaw_drift,
         gyro_rms=float(np.sqrt(np.mean(np.sum(rollout.gyro**2, axis=1)))),
@@ -105,6 +134,8 @@ def walk_metrics(rollout, expected_distance: float, q_ref: np.ndarray | None = N
         joint_rms_error_rad=float(np.sqrt(np.mean(err**2))),
         torque_saturation=sat,
         saturated_joint=joint,
+        commanded_turn_deg=float(np.degrees(cmd[-1, 2])),
+        commanded_side_m=float(cmd[-1, 1]),
     )
 
 

@@ -43,7 +43,7 @@ def _one(args) -> ModelRun:
     robot, q, q0, options, expected_fn, seed, engine = args
     plant = make_plant(robot, options, engine)
     ro = playback(plant, q, q0=q0)
-    m = walk_metrics(ro, expected_fn(ro.seconds), q_ref=q)
+    m = walk_metrics(ro, expected_fn(ro.seconds), q_ref=q, track=expected_fn.track(ro.seconds))
     return ModelRun(seed, m, walked(m))
 
 
@@ -53,6 +53,9 @@ class _Expected:
 
     def __call__(self, seconds: float) -> float:
         return self.ref.expected_distance(self.scale, seconds)
+
+    def track(self, seconds: float) -> np.ndarray:
+        return self.ref.track(self.scale, seconds)
 
 
 def play_reference(
@@ -76,6 +79,7 @@ def play_reference(
         engine: physics engine, one of :data:`imitwalk.sim.ENGINES`.
     """
     q = ref.trajectory(scale, seconds)
+    base = ref.sim_options(base)  # on the ground the gait was built for
     jobs = [(robot, q, q[0], perturbed(s, base), _Expected(ref, scale), s, engine) for s in seeds]
     return run_parallel(_one, jobs, workers)
 

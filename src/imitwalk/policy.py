@@ -75,6 +75,11 @@ class WalkPolicy:
         self._step_k = 0
         self._v: float | None = None  # the plan's clock once the feet step [ticks]
         self._gyro_sum, self._gyro_n = np.zeros(4), 0
+        # a turning reference: the channels see the heading and yaw rate beyond its turn
+        ref = gait.ref
+        turning = ref.plan and abs(ref.motion_at(scale)[2]) > 0.0
+        self._cmd_heading = ref.plan_at(scale)["path"][:, 2] if turning else None
+        self._cmd_turn = float(ref.motion_at(scale)[2]) if turning else 0.0
 
     @property
     def first_loop_tick(self) -> int:
@@ -101,7 +106,7 @@ class WalkPolicy:
         # tick, slower or faster over a step whose ``time`` channel is not 0
         v = float(k) if self._v is None else self._v
         q = self._base(v, est)
-        offsets = self._channels(v - self._clock0, est)
+        offsets = self._channels(v - self._clock0, est, v)
         if np.any(offsets):
             q = q + self.channel_ik(v, offsets) - self._base(v, None, reference=True)
         else:
@@ -157,15 +162,29 @@ class WalkPolicy:
         self._a_prev = action
         return self.gait.joints(self.scale, action, i)
 
-    def _channels(self, j: float, est) -> np.ndarray:
-        """Step-level balance channels at stepping tick ``j`` (the plan's clock; 0 = first
-        step)."""
-        self._gyro_sum += np.r_[est.gyro, est.cop_x]
+    def commanded_heading(self, v: float) -> float:
+        """The reference's own heading [rad] at plan tick ``v`` (0 unless it turns)."""
+        if self._cmd_heading is None:
+            return 0.0
+        k, m, n = int(np.floor(v)), len(self.start), self.n
+        if k < m + n:
+            return float(self._cmd_heading[min(k, len(self._cmd_heading) - 1)])
+        c, r = divmod(k - m, n)
+        return float(self._cmd_heading[m + r] + c * self._cmd_turn)
+
+    def _channels(self, j: float, est, v: float) -> np.ndarray:
+        """Step-level balance channels at stepping tick ``j`` (the plan's clock ``v``;
+        0 = first step). Heading and yaw rate are taken relative to the reference's
+        own turn."""
+        h0 = self.commanded_heading(v)
+        rate = (self.commanded_heading(v + 1) - h0) / self.gait.ref.dt
+        self._gyro_sum += np.r_[est.gyro - [0.0, 0.0, rate], est.cop_x]
         self._gyro_n += 1
         half = self.n / 2.0
         while j >= self._step_k * half:  # a step boundary (heel strike): decide
             mean = self._gyro_sum / max(self._gyro_n, 1)  # gyro (3) and cop_x over the step
-            state = np.array([est.roll, est.pitch, est.heading, *mean[:3], est.load_left, mean[3]])
+            heading = est.heading - h0
+            state = np.array([est.roll, est.pitch, heading, *mean[:3], est.load_left, mean[3]])
             self.steps.decide(state, self._step_k)
             self._step_k += 1
             self._gyro_sum, self._gyro_n = np.zeros(4), 0

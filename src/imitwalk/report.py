@@ -227,6 +227,20 @@ def _sections(
             ),
         ),
         (
+            "Path",
+            _figure(
+                _img(
+                    curves.torso_paths(
+                        [(n, ro.torso_pos) for n, ro in rp.runs],
+                        lg.ref.ground_path(scale, rp.after.seconds),
+                    ),
+                    "torso paths",
+                ),
+                f"The replays above from above; dashed: the path the reference commands "
+                f"({lg.ref.gait_command().describe()}).",
+            ),
+        ),
+        (
             "Torso gyro",
             _figure(
                 _img(gyro, "gyro traces"),

@@ -16,6 +16,7 @@ import numpy as np
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.mocap.motion import Motion
 from imitwalk.retarget.cadence import with_cadence
+from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
@@ -25,6 +26,7 @@ from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
 
 __all__ = [
+    "GaitCommand",
     "GaitParams",
     "GaitTemplate",
     "Reference",
@@ -49,6 +51,8 @@ class RetargetConfig:
         search: run the parameter search (else ``params`` is used as is).
         params: reference parameters (the search's starting point).
         search_config: the search's budget.
+        command: turn, sidestep, stride fraction and slope
+            (:class:`~imitwalk.retarget.command.GaitCommand`; default straight, level).
         cadence: play the loop this many times as fast as the human walked
             (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
             the human's cadence). 1: the human's own.
@@ -63,6 +67,7 @@ class RetargetConfig:
     params: GaitParams = field(default_factory=GaitParams)
     search_config: SearchConfig = field(default_factory=SearchConfig)
     cadence: float = 1.0
+    command: GaitCommand = field(default_factory=GaitCommand)
 
 
 @dataclass
@@ -127,6 +132,8 @@ def retarget(
     template = extract_template(motion)
     dt = 1.0 / cfg.control_hz
     t0 = time.perf_counter()
+    if cfg.mapping == "paper" and not cfg.command.straight:
+        raise ConfigError("a turn, sidestep, stride fraction or slope needs mapping=walkable")
     if cfg.mapping == "paper":
         ref = build_paper(motion, template, robot, cfg.scales, dt)
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
@@ -135,9 +142,15 @@ def retarget(
         params, report = cfg.params, {}
         if cfg.search:
             params, report = search_params(
-                template, robot, cfg.search_config, cfg.params, dt, progress=progress
+                template,
+                robot,
+                cfg.search_config,
+                cfg.params,
+                dt,
+                progress=progress,
+                command=cfg.command,
             )
-        build = build_walkable(template, robot, params, cfg.scales, dt)
+        build = build_walkable(template, robot, params, cfg.scales, dt, command=cfg.command)
         ref, frames, seconds = build.reference, build.frames, build.seconds
     ref.search = report
     ref.source = motion.source

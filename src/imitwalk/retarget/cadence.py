@@ -23,9 +23,6 @@ from imitwalk.retarget.reference import Reference
 
 __all__ = ["with_cadence"]
 
-#: Plan arrays whose first component moves forward by one stride per loop.
-_ADVANCING = ("l_sole", "r_sole", "com")
-
 
 def _resample(a: np.ndarray, u: np.ndarray, after: np.ndarray) -> np.ndarray:
     """``a`` ``(S, N, ...)`` at fractional ticks ``u`` ``(N2,)`` in [0, N), linearly;
@@ -59,11 +56,15 @@ def with_cadence(ref: Reference, rate: float) -> Reference:
     near = np.rint(u).astype(int) % n
     loops = _resample(ref.loops, u, ref.loops[:, 0])
     plan = {}
+    # the tick after the loop: its first tick, one cycle on (a stride ahead, or turned)
+    after = (
+        [ref.plan_row(ref.plan_at(s), ref.motion_at(s), m + n) for s in ref.scales]
+        if ref.plan
+        else []
+    )
     for key, arr in ref.plan.items():
         loop = arr[:, m:]
-        ahead = loop[:, 0].copy()
-        if key in _ADVANCING:
-            ahead[:, 0] += ref.strides
+        ahead = np.stack([a[key] for a in after])
         plan[key] = np.concatenate([arr[:, :m], _resample(loop, u, ahead)], axis=1)
     phase = _resample(ref.phase[None], u, np.ones(1))[0] % 1.0
     residual = np.concatenate([ref.residual_mm[:, :m], ref.residual_mm[:, m:][:, near]], axis=1)

@@ -1,10 +1,12 @@
 """Whole-body IK on the robot with mink: task-space plan → joint angles.
 
 Per control tick the free-floating pelvis and the legs are solved so that both soles
-reach their planned poses (flat), the centre of mass its planned x, y and the pelvis its
-height and a level, forward orientation; the arms and waist are set from the plan.
-Joint limits are constraints of the IK (``mink.ConfigurationLimit``); any joint that
-ends at a limit is reported. Warm-started from the previous tick.
+reach their planned poses (flat on the ground, turned to their planned headings), the
+centre of mass its planned x, y and the pelvis its height and orientation (level, or
+pitched into a slope, and turned to the walking frame's heading); the arms and waist
+are set from the plan. Joint limits are constraints of the IK
+(``mink.ConfigurationLimit``); any joint that ends at a limit is reported.
+Warm-started from the previous tick.
 """
 
 from __future__ import annotations
@@ -72,6 +74,12 @@ def leg_geometry(robot: Robot) -> LegGeometry:
         foot_length=float(max(lengths)),
         hip_ahead=hip_ahead,
     )
+
+
+def _rz(th: float) -> np.ndarray:
+    """``(3, 3)`` rotation by ``th`` [rad] about z."""
+    c, s = np.cos(th), np.sin(th)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _body_of(model: mujoco.MjModel, name: str) -> str:
@@ -152,18 +160,23 @@ class WalkIK:
                 j = r.index(role)
                 target_q[self._qadr[j]] = (base[j] + val[i]) * r.signs[j]
         self.posture.set_target(target_q)
+        yaw = getattr(plan, "yaw", None)
+        yaw = np.zeros(3) if yaw is None else yaw[i]
+        heading = _rz(yaw[2])[:2, :2]  # the channels' offsets are in the walking frame
         for k, (s, sole) in enumerate((("l", plan.l_sole), ("r", plan.r_sole))):
             dx, dy, dyaw = offset[3 * k : 3 * k + 3]
-            c, sn = np.cos(dyaw), np.sin(dyaw)
             pose = np.eye(4)
-            pose[:3, :3] = (
-                np.array([[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]]) @ self._sole_rot[s]
-            )
-            pose[:3, 3] = sole[i] + np.array([dx, dy, 0.0])
+            pose[:3, :3] = _rz(yaw[k] + dyaw) @ self._sole_rot[s]
+            pose[:3, 3] = sole[i] + np.r_[heading @ np.array([dx, dy]), 0.0]
             self.tasks[s].set_target(mink.SE3.from_matrix(pose))
-        com = plan.com[i] + np.array([offset[7], offset[6]])
+        com = plan.com[i] + heading @ np.array([offset[7], offset[6]])
         self.com.set_target(np.array([com[0], com[1], 0.0]))
-        self.pelvis.set_target(mink.SE3.from_translation(np.array([0.0, 0.0, plan.pelvis_z[i]])))
+        pelvis = np.eye(4)
+        pitch = float(getattr(plan, "pitch", 0.0))
+        c, sn = np.cos(pitch), np.sin(pitch)
+        pelvis[:3, :3] = _rz(yaw[2]) @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
+        pelvis[2, 3] = plan.pelvis_z[i]
+        self.pelvis.set_target(mink.SE3.from_matrix(pelvis))
 
     def _converge(self, max_iter: int) -> int:
         tasks = [self.tasks["l"], self.tasks["r"], self.com, self.pelvis, self.posture]

@@ -29,37 +29,21 @@ class OnlineIK:
 
     def __init__(self, robot: Robot, ref: Reference, scale: float):
         self.ik = WalkIK(robot)
+        self.ref = ref
         self.plan = ref.plan_at(scale)
-        self.n_loop = ref.loops.shape[1]
-        self.n_total = len(self.plan["pelvis_z"])
-        self.m = self.n_total - self.n_loop
-        self.stride = ref.at_scale(scale)[2]
+        self.motion = ref.motion_at(scale)
+        self.pitch = float(np.radians(ref.gait_command().slope_deg))
         self._fresh = True
         self.ik.start(robot.stand_qpos)
 
-    def _plan_row(self, k: int) -> dict:
-        if k < self.n_total:
-            i, shift = k, 0.0
-        else:
-            c, r = divmod(k - self.m, self.n_loop)
-            i, shift = self.m + r, c * self.stride
-        p = self.plan
-        dx = np.array([shift, 0.0, 0.0])
-        return {
-            "l_sole": p["l_sole"][i] + dx,
-            "r_sole": p["r_sole"][i] + dx,
-            "com": p["com"][i] + dx[:2],
-            "pelvis_z": p["pelvis_z"][i],
-            "upper": p["upper"][i],
-        }
-
     def _tick_plan(self, k: float) -> SimpleNamespace:
-        """The plan at tick ``k``, linear between ticks for a fractional ``k``."""
+        """The plan at tick ``k``, linear between ticks for a fractional ``k``; past the
+        stored start-up and loop, the loop repeats, moved on by one cycle's motion."""
         k0 = int(np.floor(k))
-        row = self._plan_row(k0)
+        row = self.ref.plan_row(self.plan, self.motion, k0)
         a = k - k0
         if a > 0.0:
-            nxt = self._plan_row(k0 + 1)
+            nxt = self.ref.plan_row(self.plan, self.motion, k0 + 1)
             row = {key: (1.0 - a) * row[key] + a * nxt[key] for key in row}
         return SimpleNamespace(
             l_sole=row["l_sole"][None],
@@ -67,6 +51,8 @@ class OnlineIK:
             com=row["com"][None],
             pelvis_z=np.atleast_1d(row["pelvis_z"]),
             upper={u: row["upper"][j : j + 1] for j, u in enumerate(UPPER)},
+            yaw=row["yaw"][None],
+            pitch=self.pitch,
         )
 
     def __call__(self, k: float, offsets: np.ndarray) -> np.ndarray:

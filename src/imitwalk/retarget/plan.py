@@ -13,6 +13,10 @@ control tick:
 * the **pelvis** level, at a fixed height chosen to keep the knee bent;
 * the **arms and waist** swinging as the human's do (scaled with the stride).
 
+A :class:`~imitwalk.retarget.command.GaitCommand` bends this straight, level walk into
+a turn, a sidestep or a walk up or down a slope: everything above is laid out relative
+to a moving *walking frame* (see :mod:`imitwalk.retarget.command`).
+
 Timing: the human cycle time; ``ds`` double support per transition; ψ = 0 is the left
 heel strike, the right foot swings in ψ ∈ [ds, ½), the left in [½ + ds, 1). An
 amplitude envelope ``e(t)`` ∈ [0, 1] scales stride, sway, lift and arm swing, so one
@@ -26,11 +30,14 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from imitwalk.errors import ConfigError
+from imitwalk.retarget.command import GaitCommand, cycle_motion, place, walking_frame
 from imitwalk.retarget.template import GaitTemplate
 
 __all__ = [
     "KNEE_MIN_DEG",
     "START_CYCLES",
+    "GaitCommand",
     "GaitParams",
     "LegGeometry",
     "TaskPlan",
@@ -104,7 +111,11 @@ class LegGeometry:
 class TaskPlan:
     """Per-tick task-space targets (``N`` ticks of ``dt``).
 
-    ``l_sole``/``r_sole`` ``(N, 3)`` sole-centre positions [m] (soles flat, heading +x);
+    ``l_sole``/``r_sole`` ``(N, 3)`` sole-centre positions [m] (soles flat on the ground);
+    ``yaw`` ``(N, 3)`` heading of the left sole, the right sole and the pelvis [rad]
+    (0: +x); ``pitch`` the pelvis's forward pitch [rad] (into a slope); ``path`` ``(N, 5)``
+    the walking frame (:data:`~imitwalk.retarget.command.PATH_COLUMNS`); ``motion``
+    ``(5,)`` how one steady cycle moves it (:func:`~imitwalk.retarget.command.cycle_motion`);
     ``com`` ``(N, 2)`` centre of mass x, y [m]; ``pelvis_z`` ``(N,)`` pelvis-frame
     height [m]; ``upper`` dict role → ``(N,)`` arm and waist angles [rad], offsets from
     the standing posture; ``phase`` ``(N,)`` ψ; ``stance`` ``(N, 2)`` bool, left/right
@@ -124,6 +135,10 @@ class TaskPlan:
     envelope: np.ndarray
     stride: float
     period: float
+    yaw: np.ndarray | None = None
+    pitch: float = 0.0
+    path: np.ndarray | None = None
+    motion: np.ndarray | None = None
 
 
 def _smoothstep(x: np.ndarray) -> np.ndarray:
@@ -145,6 +160,7 @@ def plan_walk(
     cycles: int = 1,
     start: bool = False,
     cap_scale: float | None = 1.0,
+    command: GaitCommand | None = None,
 ) -> TaskPlan:
     """Lay out ``cycles`` steady cycles, after :data:`START_CYCLES` start-up cycles if ``start``.
 
@@ -160,11 +176,26 @@ def plan_walk(
         cap_scale: the longest stride the gait is built for; the hip is never higher
             than :func:`knee_cap` allows at that stride (or at ``scale`` if longer), so
             the knee stays bent; ``None`` for no cap.
+        command: turn, sidestep, stride fraction and slope (default: straight ahead on
+            level ground); a turn or sidestep needs ``start``.
+
+    Raises:
+        ConfigError: a sidestep so long that the feet would cross, or a turn or
+            sidestep without ``start``.
     """
+    cmd = command or GaitCommand()
     n_cyc = max(2, round(template.period / dt))
     period = n_cyc * dt
-    stride = scale * template.stride * geom.leg / template.leg_length
+    stride = cmd.forward * scale * template.stride * geom.leg / template.leg_length
     ds = float(np.clip(params.ds, 0.0, 0.45))
+    y_foot = geom.hip_y + params.width
+    if abs(cmd.side_m * scale) / 2 > y_foot:
+        raise ConfigError(
+            f"command side_m={cmd.side_m} at scale {scale}: the feet would cross; "
+            f"expected |side_m| * scale <= {2 * y_foot:.3f} m for this robot"
+        )
+    if not start and (cmd.turn_deg or cmd.side_m):
+        raise ConfigError("a turning or sidestepping plan needs start=True")
     ramp = START_CYCLES if start else 0
     n_out = n_cyc * (ramp + cycles)
     n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
@@ -176,19 +207,23 @@ def plan_walk(
     e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
     e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
     stepping = k >= (n_cyc if start else 0)
-    v = stride / period
-    com_x = np.cumsum(e) * v * dt - e[0] * v * dt  # (N,) integrated forward travel
+    path = walking_frame(e, stride / period, cmd, scale, period, dt)  # (N, 5)
     if not start:  # steady: CoM midway between the feet at mid double support
-        com_x = com_x - stride / 4 - stride * ds / 2
-    y_foot = geom.hip_y + params.width
+        path[:, 0] -= stride / 4 + stride * ds / 2
     com_y = e_sway * params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
     soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
+    yaw = np.zeros((n, 3))
+    yaw[:, 2] = path[:, 2]
     stance = np.zeros((n, 2), dtype=bool)
     swing = np.full((n, 2), np.nan)
     # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
     windows = {"r": (ds, 0.5), "l": (0.5 + ds, 1.0)}
-    land_x = {"l": 0.0, "r": 0.0 if start else -stride / 2}
-    lift_off = dict(land_x)
+    side = {"l": y_foot, "r": -y_foot}
+    land = {  # where each foot stands: x, y [m] and heading [rad]
+        "l": np.array([0.0, y_foot, 0.0]),
+        "r": np.array([0.0 if start else -stride / 2, -y_foot, 0.0]),
+    }
+    lift_off = dict(land)
     shape_z = np.maximum(
         template.swing_z, np.sin(np.pi * np.linspace(0.0, 1.0, len(template.swing_z)))
     )
@@ -199,21 +234,29 @@ def plan_walk(
             if stepping[i] and a <= psi[i] < b:
                 sigma = (psi[i] - a) / (b - a)
                 if sigma * (b - a) * n_cyc < 1.0:  # first swing tick: choose the landing spot
-                    lift_off[f] = land_x[f]
+                    lift_off[f] = land[f]
                     t_mid = i - sigma * (b - a) * n_cyc + (b - a + ds / 2) * n_cyc  # fractional
-                    land_x[f] = _com_at(com_x, t_mid) + _com_at(e, t_mid) * stride / 4
-                x = lift_off[f] + (land_x[f] - lift_off[f]) * _profile(template.swing_x, sigma)
-                z = params.lift * _profile(shape_z, sigma)
-                soles[f][i] = (x, 0.0, z)
+                    ahead = float(np.interp(t_mid, k, e)) * stride / 4
+                    xy, th = place(path, t_mid, np.array([ahead, side[f]]))
+                    land[f] = np.array([*xy, th])
+                u = _profile(template.swing_x, sigma)
+                soles[f][i, :2] = lift_off[f][:2] + (land[f][:2] - lift_off[f][:2]) * u
+                soles[f][i, 2] = params.lift * _profile(shape_z, sigma)
+                yaw[i, j] = lift_off[f][2] + (land[f][2] - lift_off[f][2]) * u
                 swing[i, j] = sigma
             else:
-                soles[f][i] = (land_x[f], 0.0, 0.0)
+                soles[f][i] = (*land[f][:2], 0.0)
+                yaw[i, j] = land[f][2]
                 stance[i, j] = True
-    soles["l"][:, 1], soles["r"][:, 1] = y_foot, -y_foot
     hip = params.height * geom.hip_height
     if cap_scale is not None:
-        hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start))
+        hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start, cmd))
     pelvis_z = np.full(n, hip + geom.hip_z)
+    pitch = float(np.radians(cmd.slope_deg))
+    # on a slope the CoM sits over the feet along gravity: its height × tan(slope) uphill
+    lean = params.lean + (hip + geom.hip_z) * np.tan(pitch)
+    c, s = np.cos(path[:, 2]), np.sin(path[:, 2])
+    com = path[:, :2] + np.stack([c * lean - s * com_y, s * lean + c * com_y], axis=1)
     grid = np.arange(len(template.waist)) / len(template.waist)
     arm = lambda prof: np.interp(psi, grid, prof, period=1.0)  # noqa: E731
     amp = e * scale
@@ -229,7 +272,7 @@ def plan_walk(
         dt=dt,
         l_sole=soles["l"][cut],
         r_sole=soles["r"][cut],
-        com=np.stack([com_x + params.lean, com_y], axis=1)[cut],
+        com=com[cut],
         pelvis_z=pelvis_z[cut],
         upper={key: val[cut] for key, val in upper.items()},
         phase=psi[cut],
@@ -238,11 +281,20 @@ def plan_walk(
         envelope=e[cut],
         stride=stride,
         period=period,
+        yaw=yaw[cut],
+        pitch=pitch,
+        path=path[cut],
+        motion=cycle_motion(path, n_out - n_cyc, n_cyc),
     )
 
 
 def knee_cap(
-    template: GaitTemplate, geom: LegGeometry, params: GaitParams, scale: float, start: bool = True
+    template: GaitTemplate,
+    geom: LegGeometry,
+    params: GaitParams,
+    scale: float,
+    start: bool = True,
+    command: GaitCommand | None = None,
 ) -> float:
     """Highest hip height above the soles [m] that keeps the knee bent ``KNEE_MIN_DEG``.
 
@@ -250,19 +302,20 @@ def knee_cap(
     ``start``, with a steady cycle after it: at every tick, each
     ankle (sole minus its offsets) must be within ``leg * cos(κ/2)`` of its hip (thigh and
     shank taken as equal, so a knee bent by κ shortens the leg by that factor), the hip
-    taken ``hip_ahead`` in front of the centre of mass and ``hip_y`` to the side.
+    taken ``hip_ahead`` in front of the centre of mass and ``hip_y`` to the side (both
+    turned with the pelvis, the ankle offset with its sole).
     """
-    plan = plan_walk(template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None)
+    plan = plan_walk(
+        template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None, command=command
+    )
     reach = geom.leg * np.cos(np.radians(KNEE_MIN_DEG) / 2)
+    c, s = np.cos(plan.yaw[:, 2]), np.sin(plan.yaw[:, 2])
     best = np.inf
-    for side, sole in ((1.0, plan.l_sole), (-1.0, plan.r_sole)):
-        dx = plan.com[:, 0] + geom.hip_ahead - (sole[:, 0] - geom.sole_x)
-        dy = plan.com[:, 1] + side * geom.hip_y - sole[:, 1]
+    for j, (side, sole) in enumerate(((1.0, plan.l_sole), (-1.0, plan.r_sole))):
+        hip_x = plan.com[:, 0] + c * geom.hip_ahead - s * side * geom.hip_y
+        hip_y = plan.com[:, 1] + s * geom.hip_ahead + c * side * geom.hip_y
+        dx = hip_x - (sole[:, 0] - np.cos(plan.yaw[:, j]) * geom.sole_x)
+        dy = hip_y - (sole[:, 1] - np.sin(plan.yaw[:, j]) * geom.sole_x)
         dz2 = np.maximum(reach**2 - dx**2 - dy**2, (0.5 * geom.leg) ** 2)
         best = min(best, float(np.min(np.sqrt(dz2) + sole[:, 2] + geom.ankle)))
     return best
-
-
-def _com_at(series: np.ndarray, t: float) -> float:
-    """``series`` (one value per tick) at fractional tick ``t``, linearly interpolated."""
-    return float(np.interp(t, np.arange(len(series)), series))

@@ -11,17 +11,21 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
 from imitwalk.errors import RunError
+from imitwalk.retarget.command import GaitCommand, advance
+from imitwalk.simtypes import SimOptions
 
 __all__ = ["PLAN_KEYS", "Reference", "atomic_write", "plan_arrays"]
 
-#: Arrays of a stored task-space plan (upper-body roles in :data:`UPPER`).
-PLAN_KEYS = ("l_sole", "r_sole", "com", "pelvis_z", "upper")
+#: Arrays of a stored task-space plan (upper-body roles in :data:`UPPER`; ``yaw`` and
+#: ``path`` as in :class:`~imitwalk.retarget.plan.TaskPlan`; references written before
+#: commanded gaits lack them and read as straight).
+PLAN_KEYS = ("l_sole", "r_sole", "com", "pelvis_z", "upper", "yaw", "path")
 UPPER = ("l_shoulder_pitch", "r_shoulder_pitch", "l_elbow", "r_elbow", "waist_yaw")
 
 
@@ -34,6 +38,8 @@ def plan_arrays(plan) -> dict[str, np.ndarray]:
         "com": plan.com,
         "pelvis_z": plan.pelvis_z,
         "upper": upper,
+        "yaw": plan.yaw,
+        "path": plan.path,
     }
 
 
@@ -79,6 +85,10 @@ class Reference:
         plan: the task-space plan the walkable IK solved, per scale and tick of the
             start-up and loop (``(S, M + N, ...)`` arrays named by :data:`PLAN_KEYS`);
             empty for the paper's mapping. The balance channels re-solve it with offsets.
+        command: the :class:`~imitwalk.retarget.command.GaitCommand` it was built for
+            (empty: straight ahead on level ground).
+        motion: ``(S, 5)`` how one loop moves the walking frame, per scale
+            (:func:`~imitwalk.retarget.command.cycle_motion`); empty: one stride ahead.
     """
 
     robot: str
@@ -102,6 +112,8 @@ class Reference:
     settings: dict = field(default_factory=dict)
     cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
     plan: dict = field(default_factory=dict)
+    command: dict = field(default_factory=dict)
+    motion: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
 
     # -- access ---------------------------------------------------------------
     def _bracket(self, scale: float) -> tuple[int, int, float]:
@@ -129,7 +141,74 @@ class Reference:
         if not self.plan:
             raise RunError("this reference has no task-space plan (the paper's mapping?)")
         i, j, w = self._bracket(scale)
-        return {k: (1.0 - w) * v[i] + w * v[j] for k, v in self.plan.items()}
+        out = {k: (1.0 - w) * v[i] + w * v[j] for k, v in self.plan.items()}
+        n = out["pelvis_z"].shape[0]
+        if "yaw" not in out:  # written before commanded gaits: straight ahead
+            out["yaw"] = np.zeros((n, 3))
+        if "path" not in out:
+            fwd = out["com"][:, 0] - out["com"][0, 0]
+            out["path"] = np.stack([fwd, 0 * fwd, 0 * fwd, fwd, 0 * fwd], axis=1)
+        return out
+
+    def motion_at(self, scale: float) -> np.ndarray:
+        """``(5,)`` how one loop at ``scale`` moves the walking frame (blended between
+        grid scales): displacement x, y [m] in the frame, heading change [rad], forward
+        and sideways travel [m]."""
+        i, j, w = self._bracket(scale)
+        if len(self.motion) == 0:  # written before commanded gaits: one stride ahead
+            stride = (1.0 - w) * self.strides[i] + w * self.strides[j]
+            return np.array([stride, 0.0, 0.0, stride, 0.0])
+        return (1.0 - w) * self.motion[i] + w * self.motion[j]
+
+    def plan_row(self, plan: dict, motion: np.ndarray, k: int) -> dict:
+        """Tick ``k`` from standing of ``plan`` (:meth:`plan_at`), the loop repeated and
+        moved on by ``motion`` (:meth:`motion_at`) per cycle."""
+        m, n = self.starts.shape[1], self.loops.shape[1]
+        if k < m + n:
+            return {key: v[k] for key, v in plan.items()}
+        c, r = divmod(k - m, n)
+        row = {key: v[m + r] for key, v in plan.items()}
+        return advance(row, plan["path"][m], motion, c)
+
+    def track(self, scale: float, seconds: float) -> np.ndarray:
+        """``(T, 3)`` the walking frame's commanded forward and sideways travel [m] and
+        heading [rad] at each control tick of ``seconds`` from standing (straight: the
+        forward travel of :meth:`expected_distance`, then zeros)."""
+        steps = max(1, round(seconds / self.dt))
+        if not self.plan:
+            out = np.zeros((steps, 3))
+            out[:, 0] = [self.expected_distance(scale, (k + 1) * self.dt) for k in range(steps)]
+            return out
+        plan, motion = self.plan_at(scale), self.motion_at(scale)
+        m, n = self.starts.shape[1], self.loops.shape[1]
+        path = plan["path"]
+        k = np.arange(steps)
+        c = np.maximum(0, (k - m) // n)
+        i = np.where(k < m, k, m + (k - m) % n)
+        i = np.minimum(i, len(path) - 1)
+        out = path[i][:, [3, 4, 2]] - path[0][[3, 4, 2]]
+        return out + c[:, None] * motion[[3, 4, 2]]
+
+    def ground_path(self, scale: float, seconds: float) -> np.ndarray:
+        """``(T, 2)`` the walking frame's commanded path on the ground [m] from the start,
+        per control tick (:meth:`track` integrated in the turning frame)."""
+        tr = self.track(scale, seconds)
+        d = np.diff(tr[:, :2], axis=0, prepend=tr[:1, :2])
+        h = tr[:, 2]
+        dx = d[:, 0] * np.cos(h) - d[:, 1] * np.sin(h)
+        dy = d[:, 0] * np.sin(h) + d[:, 1] * np.cos(h)
+        return np.stack([np.cumsum(dx), np.cumsum(dy)], axis=1)
+
+    def gait_command(self) -> GaitCommand:
+        """The command the reference was built for."""
+        return GaitCommand.from_dict(self.command)
+
+    def sim_options(self, base: SimOptions | None = None) -> SimOptions:
+        """``base`` (default options if ``None``) on the ground the gait was built for:
+        the command's slope added to ``base``'s own."""
+        base = base or SimOptions()
+        slope = float(self.command.get("slope_deg", 0.0)) if self.command else 0.0
+        return replace(base, slope_deg=base.slope_deg + slope) if slope else base
 
     def trajectory(self, scale: float, seconds: float) -> np.ndarray:
         """``(T, n)`` joint targets for ``seconds``: the start-up, then the loop repeated."""
@@ -203,6 +282,7 @@ class Reference:
             "strides_m": self.strides.tolist(),
             "params": self.params,
             "checks": self.checks,
+            "command": self.gait_command().to_dict(),
             "source": self.source,
         }
 

@@ -19,6 +19,7 @@ from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed, train_seeds
+from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.template import GaitTemplate
@@ -74,16 +75,20 @@ _IK: dict = {}
 
 
 def _trial(job) -> dict:
-    template, robot, params, cfg, dt, base = job
+    template, robot, params, cfg, dt, base, command = job
     key = (robot.name, str(robot.mjcf))
     ik = _IK.setdefault(key, WalkIK(robot))
-    ref = build_walkable(template, robot, params, list(cfg.scales), dt, ik=ik).reference
+    scales = list(cfg.scales)
+    ref = build_walkable(template, robot, params, scales, dt, ik=ik, command=command).reference
+    base = ref.sim_options(base)
     runs, score = [], []
     for s in cfg.scales:
         q = ref.trajectory(s, cfg.seconds)
         for seed in train_seeds(cfg.models):
             ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
-            m = walk_metrics(ro, ref.expected_distance(s, ro.seconds))
+            m = walk_metrics(
+                ro, ref.expected_distance(s, ro.seconds), track=ref.track(s, ro.seconds)
+            )
             val = (
                 ro.seconds / cfg.seconds
                 + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
@@ -111,8 +116,10 @@ def search_params(
     dt: float = 0.01,
     base: SimOptions | None = None,
     progress=None,
+    command: GaitCommand | None = None,
 ) -> tuple[GaitParams, dict]:
-    """Find reference parameters for ``template`` on ``robot``.
+    """Find reference parameters for ``template`` on ``robot`` (walking as ``command``
+    says: a turn or sidestep is judged against its own path, a slope on its slope).
 
     Returns:
         the best parameters found and a JSON-able report of every trial.
@@ -134,7 +141,7 @@ def search_params(
         cands = [
             GaitParams(**dict(zip(names, (lo + ui * (hi - lo)).tolist(), strict=True))) for ui in u
         ]
-        jobs = [(template, robot, c, cfg, dt, base) for c in cands]
+        jobs = [(template, robot, c, cfg, dt, base, command) for c in cands]
         results = run_parallel(_trial, jobs, cfg.workers)
         scores = np.array([r["score"] for r in results])
         order = np.argsort(-scores, kind="stable")

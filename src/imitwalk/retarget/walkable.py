@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.retarget.checks import kinematic_checks
+from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.plan import GaitParams, plan_walk
 from imitwalk.retarget.reference import PLAN_KEYS, Reference, plan_arrays
@@ -39,6 +40,7 @@ def build_walkable(
     dt: float,
     ik: WalkIK | None = None,
     check_scale: float = 1.0,
+    command: GaitCommand | None = None,
 ) -> WalkableBuild:
     """Solve the walkable reference at every scale.
 
@@ -48,11 +50,13 @@ def build_walkable(
         dt: control period [s].
         ik: a solver to reuse (built if ``None``).
         check_scale: the scale whose kinematics are checked (nearest in the grid).
+        command: turn, sidestep, stride fraction and slope (default: straight, level).
     """
     ik = ik or WalkIK(robot)
     geom = leg_geometry(robot)
     scales = np.asarray(sorted(scales), dtype=float)
-    starts, loops, strides, resid, clipped, travel = [], [], [], [], [], []
+    command = command or GaitCommand()
+    starts, loops, strides, resid, clipped, travel, motion = [], [], [], [], [], [], []
     plans: dict[str, list] = {k: [] for k in PLAN_KEYS}
     t0 = time.perf_counter()
     frames = 0
@@ -62,7 +66,9 @@ def build_walkable(
         # two start-up cycles and two steady ones: by the last cycle every foot has
         # landed by the steady rule, so that cycle is the closed loop and the rest,
         # which ends exactly where the loop begins, is the start-up
-        plan = plan_walk(template, geom, params, float(s), dt, cycles=2, start=True)
+        plan = plan_walk(
+            template, geom, params, float(s), dt, cycles=2, start=True, command=command
+        )
         res = ik.solve(plan)
         frames += len(plan.phase)
         n_loop = round(plan.period / dt)
@@ -70,7 +76,8 @@ def build_walkable(
         starts.append(res.q[:m])
         loops.append(res.q[m:])
         strides.append(plan.stride)
-        travel.append(plan.com[:m, 0] - plan.com[0, 0])
+        travel.append(plan.path[:m, 3] - plan.path[0, 3])
+        motion.append(plan.motion)
         for key, val in plan_arrays(plan).items():
             plans[key].append(val)
         resid.append(res.residual_mm)
@@ -110,5 +117,7 @@ def build_walkable(
         checks=checks,
         params=params.to_dict(),
         plan={k: np.stack(v) for k, v in plans.items()},
+        command=command.to_dict(),
+        motion=np.stack(motion),
     )
     return WalkableBuild(ref, frames, elapsed)
