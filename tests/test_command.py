@@ -250,3 +250,25 @@ def test_the_learner_sees_heading_beyond_the_commanded_turn(turning):
     half = WalkPolicy(gait, 0.5)  # half the scale: half the turn
     assert half.commanded_heading(2000) == pytest.approx(turning.track(0.5, 30.0)[2000, 2])
     assert half.commanded_heading(2000) == pytest.approx(tr[2000, 2] / 2, rel=0.05)
+
+
+@pytest.mark.slow
+def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
+    """The whole loop on a turning reference: learned, evaluated against its own path."""
+    from conftest import TINY
+    from imitwalk.config import apply_overrides
+    from imitwalk.evaluate import evaluate_run
+    from imitwalk.learnconfig import preset
+    from imitwalk.learner import learn
+
+    cmd = GaitCommand(turn_deg=12.0)
+    ref = build_walkable(template, robot, GaitParams(), [0.3, 0.4], 0.01, command=cmd).reference
+    cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2"])
+    summary = learn(ref, robot, cfg, tmp_path / "run")
+    assert summary["scale_reached"] is not None
+    ev = evaluate_run(tmp_path / "run", robot, seconds=10.0, seeds=2, workers=1)
+    for mode in ("learned", "open_loop"):
+        for r in ev[mode]["per_seed"]:
+            assert r["commanded_turn_deg"] > 20.0  # ~4.5° per cycle for 10 s
+            if not r["fell"]:  # it follows the turn: what is left is a drift, not the turn
+                assert abs(r["yaw_drift_deg"]) < r["commanded_turn_deg"] / 2

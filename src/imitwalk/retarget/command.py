@@ -170,10 +170,14 @@ def advance(row: dict, anchor: np.ndarray, motion: np.ndarray, cycles: int) -> d
     """
     if cycles == 0:
         return dict(row)
-    a = _se2(*anchor[:3])
-    m = np.linalg.matrix_power(_se2(*motion[:3]), cycles)
-    g = a @ m @ np.linalg.inv(a)
     dth = cycles * motion[2]
+    if motion[2] == 0.0:  # no turn: a plain shift (exactly k strides for a straight walk)
+        c, s = np.cos(anchor[2]), np.sin(anchor[2])
+        dx, dy = cycles * motion[0], cycles * motion[1]
+        g = np.array([[1.0, 0.0, c * dx - s * dy], [0.0, 1.0, s * dx + c * dy]])
+    else:
+        a = _se2(*anchor[:3])
+        g = a @ np.linalg.matrix_power(_se2(*motion[:3]), cycles) @ np.linalg.inv(a)
     out = dict(row)
     for key in ("l_sole", "r_sole", "com", "path"):
         if key in row:

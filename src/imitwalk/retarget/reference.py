@@ -155,8 +155,8 @@ class Reference:
         grid scales): displacement x, y [m] in the frame, heading change [rad], forward
         and sideways travel [m]."""
         i, j, w = self._bracket(scale)
-        if len(self.motion) == 0:  # written before commanded gaits: one stride ahead
-            stride = (1.0 - w) * self.strides[i] + w * self.strides[j]
+        stride = (1.0 - w) * self.strides[i] + w * self.strides[j]
+        if len(self.motion) == 0 or not np.any(self.motion[:, 1:3]):  # straight: one stride
             return np.array([stride, 0.0, 0.0, stride, 0.0])
         return (1.0 - w) * self.motion[i] + w * self.motion[j]
 
