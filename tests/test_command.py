@@ -72,16 +72,20 @@ def test_the_straight_command_is_the_straight_plan(template, geom):
 
 
 def test_a_sidestep_moves_the_feet_sideways_and_keeps_them_apart(template, geom):
-    side, scale = 0.04, 0.5
-    plan = _plan(template, geom, GaitCommand(side_m=side, forward=0.0), scale)
-    n = _n(plan)
-    assert plan.motion[1] == pytest.approx(side * scale) and plan.motion[0] == pytest.approx(0.0)
-    assert plan.l_sole[-1, 1] - plan.l_sole[-1 - n, 1] == pytest.approx(side * scale)
-    gap = plan.l_sole[:, 1] - plan.r_sole[:, 1]
-    assert gap.min() >= 2 * geom.hip_y - side * scale / 2 - 1e-9
-    assert np.ptp(plan.l_sole[:, 0]) < 1e-12  # no forward stride
-    with pytest.raises(ConfigError, match="feet would cross"):
-        _plan(template, geom, GaitCommand(side_m=0.05), 1.0 + 2 * geom.hip_y / 0.05)
+    from imitwalk.retarget.plan import FOOT_GAP
+
+    assert geom.foot_width == pytest.approx(0.065)  # the HOAP-2 model's sole
+    for side, scale in ((0.04, 0.5), (0.05, 1.0), (-0.03, 0.8)):
+        plan = _plan(template, geom, GaitCommand(side_m=side, forward=0.0), scale)
+        n = _n(plan)
+        assert plan.motion[1] == pytest.approx(side * scale) and plan.motion[0] == 0.0
+        assert plan.l_sole[-1, 1] - plan.l_sole[-1 - n, 1] == pytest.approx(side * scale)
+        gap = plan.l_sole[:, 1] - plan.r_sole[:, 1] - geom.foot_width  # between the edges
+        assert gap.min() >= FOOT_GAP - 1e-9
+        assert np.ptp(plan.l_sole[:, 0]) < 1e-12  # no forward stride
+    # a small sidestep keeps the stance the straight walk has
+    plan = _plan(template, geom, GaitCommand(side_m=0.01, forward=0.0), 0.5)
+    assert plan.l_sole[0, 1] - plan.r_sole[0, 1] == pytest.approx(2 * geom.hip_y)
 
 
 def test_a_slope_pitches_the_pelvis_and_moves_the_centre_of_mass_uphill(template, geom):

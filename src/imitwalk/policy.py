@@ -77,7 +77,7 @@ class WalkPolicy:
         self._gyro_sum, self._gyro_n = np.zeros(4), 0
         # a turning reference: the channels see the heading and yaw rate beyond its turn
         ref = gait.ref
-        turning = ref.plan and abs(ref.motion_at(scale)[2]) > 0.0
+        turning = bool(ref.plan) and abs(ref.motion_at(scale)[2]) > 0.0
         self._cmd_heading = ref.plan_at(scale)["path"][:, 2] if turning else None
         self._cmd_turn = float(ref.motion_at(scale)[2]) if turning else 0.0
 

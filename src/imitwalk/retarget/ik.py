@@ -62,9 +62,8 @@ def leg_geometry(robot: Robot) -> LegGeometry:
     hip, ankle = anchor("l_hip_pitch"), anchor("l_ankle_pitch")
     sole = _pos(m, d, robot.soles["l"])
     foot_body = m.body(_body_of(m, robot.soles["l"])).id
-    lengths = [2 * m.geom_aabb[g, 3] for g in range(m.ngeom) if m.geom_bodyid[g] == foot_body] or [
-        0.1
-    ]
+    boxes = [2 * m.geom_aabb[g, 3:5] for g in range(m.ngeom) if m.geom_bodyid[g] == foot_body]
+    lengths, widths = zip(*boxes, strict=True) if boxes else ([0.1], [0.0])
     return LegGeometry(
         hip_y=float(abs(hip[1] - pelvis[1])),
         hip_z=float(pelvis[2] - hip[2]),
@@ -73,6 +72,7 @@ def leg_geometry(robot: Robot) -> LegGeometry:
         sole_x=float(sole[0] - ankle[0]),
         foot_length=float(max(lengths)),
         hip_ahead=hip_ahead,
+        foot_width=float(max(widths)),
     )
 
 

@@ -35,6 +35,7 @@ from imitwalk.retarget.command import GaitCommand, cycle_motion, place, walking_
 from imitwalk.retarget.template import GaitTemplate
 
 __all__ = [
+    "FOOT_GAP",
     "KNEE_MIN_DEG",
     "START_CYCLES",
     "GaitCommand",
@@ -44,6 +45,9 @@ __all__ = [
     "knee_cap",
     "plan_walk",
 ]
+
+#: Least gap between the soles' edges when a sidestep's closing step lands [m].
+FOOT_GAP = 0.01
 
 #: Start-up cycles: one of sway with both feet down, then two of growing stride.
 START_CYCLES = 3
@@ -91,6 +95,7 @@ class LegGeometry:
         sole_x: sole centre ahead of the ankle [m].
         foot_length: sole length [m].
         hip_ahead: hips ahead of the centre of mass when standing [m].
+        foot_width: sole width [m] (a sidestep widens the stance to keep the feet apart).
     """
 
     hip_y: float
@@ -100,6 +105,7 @@ class LegGeometry:
     sole_x: float
     foot_length: float
     hip_ahead: float = 0.0
+    foot_width: float = 0.0
 
     @property
     def hip_height(self) -> float:
@@ -180,20 +186,19 @@ def plan_walk(
             level ground); a turn or sidestep needs ``start``.
 
     Raises:
-        ConfigError: a sidestep so long that the feet would cross, or a turn or
-            sidestep without ``start``.
+        ConfigError: a turn or sidestep without ``start``.
     """
     cmd = command or GaitCommand()
     n_cyc = max(2, round(template.period / dt))
     period = n_cyc * dt
     stride = cmd.forward * scale * template.stride * geom.leg / template.leg_length
     ds = float(np.clip(params.ds, 0.0, 0.45))
+    # a sidestep's closing step brings the feet half a sidestep closer than they stand:
+    # the stance widens if that would leave less than FOOT_GAP between the soles
     y_foot = geom.hip_y + params.width
-    if abs(cmd.side_m * scale) / 2 > y_foot:
-        raise ConfigError(
-            f"command side_m={cmd.side_m} at scale {scale}: the feet would cross; "
-            f"expected |side_m| * scale <= {2 * y_foot:.3f} m for this robot"
-        )
+    if cmd.side_m:
+        side = abs(cmd.side_m * scale)
+        y_foot = max(y_foot, (geom.foot_width + FOOT_GAP + side / 2) / 2)
     if not start and (cmd.turn_deg or cmd.side_m):
         raise ConfigError("a turning or sidestepping plan needs start=True")
     ramp = START_CYCLES if start else 0
@@ -218,7 +223,7 @@ def plan_walk(
     swing = np.full((n, 2), np.nan)
     # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
     windows = {"r": (ds, 0.5), "l": (0.5 + ds, 1.0)}
-    side = {"l": y_foot, "r": -y_foot}
+    lateral = {"l": y_foot, "r": -y_foot}
     land = {  # where each foot stands: x, y [m] and heading [rad]
         "l": np.array([0.0, y_foot, 0.0]),
         "r": np.array([0.0 if start else -stride / 2, -y_foot, 0.0]),
@@ -237,7 +242,7 @@ def plan_walk(
                     lift_off[f] = land[f]
                     t_mid = i - sigma * (b - a) * n_cyc + (b - a + ds / 2) * n_cyc  # fractional
                     ahead = float(np.interp(t_mid, k, e)) * stride / 4
-                    xy, th = place(path, t_mid, np.array([ahead, side[f]]))
+                    xy, th = place(path, t_mid, np.array([ahead, lateral[f]]))
                     land[f] = np.array([*xy, th])
                 u = _profile(template.swing_x, sigma)
                 soles[f][i, :2] = lift_off[f][:2] + (land[f][:2] - lift_off[f][:2]) * u

@@ -78,8 +78,8 @@ def _trial(job) -> dict:
     template, robot, params, cfg, dt, base, command = job
     key = (robot.name, str(robot.mjcf))
     ik = _IK.setdefault(key, WalkIK(robot))
-    scales = list(cfg.scales)
-    ref = build_walkable(template, robot, params, scales, dt, ik=ik, command=command).reference
+    build = build_walkable(template, robot, params, list(cfg.scales), dt, ik=ik, command=command)
+    ref = build.reference
     base = ref.sim_options(base)
     runs, score = [], []
     for s in cfg.scales:
