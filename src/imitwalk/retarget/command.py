@@ -29,7 +29,7 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["PATH_COLUMNS", "GaitCommand", "advance", "cycle_motion", "walking_frame"]
+__all__ = ["PATH_COLUMNS", "GaitCommand", "advance", "cycle_motion", "place", "walking_frame"]
 
 #: Columns of a plan's ``path`` array: the walking frame's position x, y [m] and heading
 #: [rad] on the ground, and the forward and sideways travel commanded so far [m]
@@ -55,7 +55,8 @@ class GaitCommand:
     Attributes:
         turn_deg: heading change per gait cycle at scale 1 [deg]; positive turns left.
         side_m: sideways travel per gait cycle at scale 1 [m]; positive to the left.
-            Bounded so that the feet keep clear of each other (see ``plan_walk``).
+            Where the closing step would bring the soles within ``FOOT_GAP`` of each
+            other, the stance widens (see :func:`~imitwalk.retarget.plan.plan_walk`).
         forward: the forward stride as a fraction of the retargeted human stride
             (0 steps on the spot: with ``turn_deg`` a turn in place, with ``side_m`` a
             pure sidestep).
