@@ -161,7 +161,7 @@ def advance(row: dict, anchor: np.ndarray, motion: np.ndarray, cycles: int) -> d
     the loop moved on by ``cycles`` whole cycles.
 
     Args:
-        row: ``{"l_sole": (3,), "r_sole": (3,), "com": (2,), "yaw": (3,), "path": (5,), ...}``.
+        row: ``{"l_sole": (3,), "r_sole": (3,), "com": (2,), "yaw": (2,), "path": (5,), ...}``.
         anchor: ``(5,)`` the walking frame at the loop's first tick (``path`` row).
         motion: ``(5,)`` one cycle's :func:`cycle_motion`; cycles: how many cycles on.
 

@@ -161,8 +161,10 @@ class WalkIK:
                 target_q[self._qadr[j]] = (base[j] + val[i]) * r.signs[j]
         self.posture.set_target(target_q)
         yaw = getattr(plan, "yaw", None)
-        yaw = np.zeros(3) if yaw is None else yaw[i]
-        heading = _rz(yaw[2])[:2, :2]  # the channels' offsets are in the walking frame
+        yaw = np.zeros(2) if yaw is None else yaw[i]  # the soles'
+        path = getattr(plan, "path", None)
+        walk = 0.0 if path is None else path[i, 2]  # the walking frame's heading
+        heading = _rz(walk)[:2, :2]  # the channels' offsets are in the walking frame
         for k, (s, sole) in enumerate((("l", plan.l_sole), ("r", plan.r_sole))):
             dx, dy, dyaw = offset[3 * k : 3 * k + 3]
             pose = np.eye(4)
@@ -174,7 +176,7 @@ class WalkIK:
         pelvis = np.eye(4)
         pitch = float(getattr(plan, "pitch", 0.0))
         c, sn = np.cos(pitch), np.sin(pitch)
-        pelvis[:3, :3] = _rz(yaw[2]) @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
+        pelvis[:3, :3] = _rz(walk) @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
         pelvis[2, 3] = plan.pelvis_z[i]
         self.pelvis.set_target(mink.SE3.from_matrix(pelvis))
 

@@ -52,6 +52,7 @@ class OnlineIK:
             pelvis_z=np.atleast_1d(row["pelvis_z"]),
             upper={u: row["upper"][j : j + 1] for j, u in enumerate(UPPER)},
             yaw=row["yaw"][None],
+            path=row["path"][None],
             pitch=self.pitch,
         )
 

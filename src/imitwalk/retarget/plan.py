@@ -118,9 +118,9 @@ class TaskPlan:
     """Per-tick task-space targets (``N`` ticks of ``dt``).
 
     ``l_sole``/``r_sole`` ``(N, 3)`` sole-centre positions [m] (soles flat on the ground);
-    ``yaw`` ``(N, 3)`` heading of the left sole, the right sole and the pelvis [rad]
-    (0: +x); ``pitch`` the pelvis's forward pitch [rad] (into a slope); ``path`` ``(N, 5)``
-    the walking frame (:data:`~imitwalk.retarget.command.PATH_COLUMNS`); ``motion``
+    ``yaw`` ``(N, 2)`` heading of the left and right sole [rad] (0: +x); ``pitch`` the
+    pelvis's forward pitch [rad] (into a slope); ``path`` ``(N, 5)`` the walking frame
+    (:data:`~imitwalk.retarget.command.PATH_COLUMNS`), whose heading the pelvis takes; ``motion``
     ``(5,)`` how one steady cycle moves it (:func:`~imitwalk.retarget.command.cycle_motion`);
     ``com`` ``(N, 2)`` centre of mass x, y [m]; ``pelvis_z`` ``(N,)`` pelvis-frame
     height [m]; ``upper`` dict role → ``(N,)`` arm and waist angles [rad], offsets from
@@ -217,8 +217,7 @@ def plan_walk(
         path[:, 0] -= stride / 4 + stride * ds / 2
     com_y = e_sway * params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
     soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
-    yaw = np.zeros((n, 3))
-    yaw[:, 2] = path[:, 2]
+    yaw = np.zeros((n, 2))
     stance = np.zeros((n, 2), dtype=bool)
     swing = np.full((n, 2), np.nan)
     # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
@@ -314,7 +313,7 @@ def knee_cap(
         template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None, command=command
     )
     reach = geom.leg * np.cos(np.radians(KNEE_MIN_DEG) / 2)
-    c, s = np.cos(plan.yaw[:, 2]), np.sin(plan.yaw[:, 2])
+    c, s = np.cos(plan.path[:, 2]), np.sin(plan.path[:, 2])
     best = np.inf
     for j, (side, sole) in enumerate(((1.0, plan.l_sole), (-1.0, plan.r_sole))):
         hip_x = plan.com[:, 0] + c * geom.hip_ahead - s * side * geom.hip_y

@@ -144,7 +144,7 @@ class Reference:
         out = {k: (1.0 - w) * v[i] + w * v[j] for k, v in self.plan.items()}
         n = out["pelvis_z"].shape[0]
         if "yaw" not in out:  # written before commanded gaits: straight ahead
-            out["yaw"] = np.zeros((n, 3))
+            out["yaw"] = np.zeros((n, 2))
         if "path" not in out:
             fwd = out["com"][:, 0] - out["com"][0, 0]
             out["path"] = np.stack([fwd, 0 * fwd, 0 * fwd, fwd, 0 * fwd], axis=1)
