@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imitwalk import plots
+from imitwalk import curves, plots
 from imitwalk.retarget.reference import atomic_write
 from imitwalk.robots import Robot
 from imitwalk.sim import MujocoPlant, Rollout, SimOptions, make_plant, playback, run
@@ -173,6 +173,11 @@ class Replays:
         if self.after.fell:
             q = q[: max(1, round(self.after.fall_time / self.after.control_dt))]
         return gait.subspace.transform(q[-2 * gait.n_ticks :])
+
+    def paths(self, ref):
+        """Top view of the two runs' torso paths and the path ``ref`` commands."""
+        commanded = ref.ground_path(self.scale, self.after.seconds)
+        return curves.torso_paths([(n, ro.torso_pos) for n, ro in self.runs], commanded)
 
     @property
     def runs(self) -> list[tuple[str, Rollout]]:

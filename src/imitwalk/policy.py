@@ -166,11 +166,8 @@ class WalkPolicy:
         """The reference's own heading [rad] at plan tick ``v`` (0 unless it turns)."""
         if self._cmd_heading is None:
             return 0.0
-        k, m, n = int(np.floor(v)), len(self.start), self.n
-        if k < m + n:
-            return float(self._cmd_heading[min(k, len(self._cmd_heading) - 1)])
-        c, r = divmod(k - m, n)
-        return float(self._cmd_heading[m + r] + c * self._cmd_turn)
+        i, c = self.gait.ref.loop_index(int(np.floor(v)))
+        return float(self._cmd_heading[i] + c * self._cmd_turn)
 
     def _channels(self, j: float, est, v: float) -> np.ndarray:
         """Step-level balance channels at stepping tick ``j`` (the plan's clock ``v``;

@@ -229,13 +229,7 @@ def _sections(
         (
             "Path",
             _figure(
-                _img(
-                    curves.torso_paths(
-                        [(n, ro.torso_pos) for n, ro in rp.runs],
-                        lg.ref.ground_path(scale, rp.after.seconds),
-                    ),
-                    "torso paths",
-                ),
+                _img(rp.paths(lg.ref), "torso paths"),
                 f"The replays above from above; dashed: the path the reference commands "
                 f"({lg.ref.gait_command().describe()}).",
             ),

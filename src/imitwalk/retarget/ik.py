@@ -160,10 +160,8 @@ class WalkIK:
                 j = r.index(role)
                 target_q[self._qadr[j]] = (base[j] + val[i]) * r.signs[j]
         self.posture.set_target(target_q)
-        yaw = getattr(plan, "yaw", None)
-        yaw = np.zeros(2) if yaw is None else yaw[i]  # the soles'
-        path = getattr(plan, "path", None)
-        walk = 0.0 if path is None else path[i, 2]  # the walking frame's heading
+        yaw = np.zeros(2) if plan.yaw is None else plan.yaw[i]  # the soles'
+        walk = 0.0 if plan.path is None else plan.path[i, 2]  # the walking frame's heading
         heading = _rz(walk)[:2, :2]  # the channels' offsets are in the walking frame
         for k, (s, sole) in enumerate((("l", plan.l_sole), ("r", plan.r_sole))):
             dx, dy, dyaw = offset[3 * k : 3 * k + 3]
@@ -174,7 +172,7 @@ class WalkIK:
         com = plan.com[i] + heading @ np.array([offset[7], offset[6]])
         self.com.set_target(np.array([com[0], com[1], 0.0]))
         pelvis = np.eye(4)
-        pitch = float(getattr(plan, "pitch", 0.0))
+        pitch = float(plan.pitch)
         c, sn = np.cos(pitch), np.sin(pitch)
         pelvis[:3, :3] = _rz(walk) @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
         pelvis[2, 3] = plan.pelvis_z[i]

@@ -160,15 +160,21 @@ class Reference:
             return np.array([stride, 0.0, 0.0, stride, 0.0])
         return (1.0 - w) * self.motion[i] + w * self.motion[j]
 
+    def loop_index(self, k):
+        """Where tick ``k`` from standing (int or int array) falls in the stored start-up
+        and loop: the stored tick ``i`` and how many whole cycles ``c`` the loop has been
+        repeated before it (0 within the stored ticks)."""
+        m, n = self.starts.shape[1], self.loops.shape[1]
+        k = np.asarray(k)
+        c = np.where(k < m + n, 0, (k - m) // n)
+        return k - c * n, c
+
     def plan_row(self, plan: dict, motion: np.ndarray, k: int) -> dict:
         """Tick ``k`` from standing of ``plan`` (:meth:`plan_at`), the loop repeated and
         moved on by ``motion`` (:meth:`motion_at`) per cycle."""
-        m, n = self.starts.shape[1], self.loops.shape[1]
-        if k < m + n:
-            return {key: v[k] for key, v in plan.items()}
-        c, r = divmod(k - m, n)
-        row = {key: v[m + r] for key, v in plan.items()}
-        return advance(row, plan["path"][m], motion, c)
+        i, c = (int(x) for x in self.loop_index(k))
+        row = {key: v[i] for key, v in plan.items()}
+        return advance(row, plan["path"][self.starts.shape[1]], motion, c)
 
     def track(self, scale: float, seconds: float) -> np.ndarray:
         """``(T, 3)`` the walking frame's commanded forward and sideways travel [m] and
@@ -179,13 +185,8 @@ class Reference:
             out = np.zeros((steps, 3))
             out[:, 0] = [self.expected_distance(scale, (k + 1) * self.dt) for k in range(steps)]
             return out
-        plan, motion = self.plan_at(scale), self.motion_at(scale)
-        m, n = self.starts.shape[1], self.loops.shape[1]
-        path = plan["path"]
-        k = np.arange(steps)
-        c = np.maximum(0, (k - m) // n)
-        i = np.where(k < m, k, m + (k - m) % n)
-        i = np.minimum(i, len(path) - 1)
+        path, motion = self.plan_at(scale)["path"], self.motion_at(scale)
+        i, c = self.loop_index(np.arange(steps))
         out = path[i][:, [3, 4, 2]] - path[0][[3, 4, 2]]
         return out + c[:, None] * motion[[3, 4, 2]]
 

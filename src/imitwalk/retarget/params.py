@@ -1,0 +1,69 @@
+"""The walkable reference's parameters and the robot's leg measures (plain records).
+
+:class:`GaitParams` are the few numbers the reference search tunes
+(:mod:`imitwalk.retarget.search`); :class:`LegGeometry` is what
+:func:`imitwalk.retarget.ik.leg_geometry` measures on the robot's model. The plan
+(:mod:`imitwalk.retarget.plan`) reads both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+__all__ = ["GaitParams", "LegGeometry"]
+
+
+@dataclass(frozen=True)
+class GaitParams:
+    """The reference's few parameters, found by trials in simulation (``search.py``).
+
+    Attributes:
+        sway: lateral CoM amplitude ÷ the lateral offset of the feet (about 0.9 worked).
+        height: hip height ÷ the straight-leg hip height (knee stays bent below 1).
+        lift: swing foot clearance at its peak [m].
+        ds: double-support fraction of the cycle, per transition (about 0.1 worked).
+        lean: centre of mass ahead of the feet's midpoint [m]; a compliant robot sags
+            backwards under its own weight, so a few millimetres may be needed.
+        width: extra lateral offset of each foot beyond its hip [m].
+    """
+
+    sway: float = 0.9
+    height: float = 0.9
+    lift: float = 0.02
+    ds: float = 0.1
+    lean: float = 0.0
+    width: float = 0.0
+
+    def to_dict(self) -> dict:
+        """Plain dictionary."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class LegGeometry:
+    """The robot's leg measures, from its model.
+
+    Attributes:
+        hip_y: lateral offset of each hip centre from the pelvis centre [m].
+        hip_z: hip centre below the pelvis frame [m] (positive down).
+        leg: hip centre to ankle with the leg straight [m].
+        ankle: ankle to sole [m].
+        sole_x: sole centre ahead of the ankle [m].
+        foot_length: sole length [m].
+        hip_ahead: hips ahead of the centre of mass when standing [m].
+        foot_width: sole width [m] (a sidestep widens the stance to keep the feet apart).
+    """
+
+    hip_y: float
+    hip_z: float
+    leg: float
+    ankle: float
+    sole_x: float
+    foot_length: float
+    hip_ahead: float = 0.0
+    foot_width: float = 0.0
+
+    @property
+    def hip_height(self) -> float:
+        """Hip centre above the sole with the leg straight [m]."""
+        return self.leg + self.ankle
