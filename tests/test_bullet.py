@@ -82,7 +82,7 @@ def test_same_seed_same_robot(robot):
     opts = perturbed(3, None)
     bp, mp = BulletPlant(robot, opts), MujocoPlant(robot, opts)
     _, kps = jitter_draws(opts, mp.model.nbody, robot.joint_names)
-    np.testing.assert_allclose(bp.kp, robot.kp * kps)
+    np.testing.assert_allclose(bp.servo.kp, robot.kp * kps)
     links = sum(
         pb.getDynamicsInfo(bp.body, i, physicsClientId=bp.client)[0]
         for i in range(-1, pb.getNumJoints(bp.body, physicsClientId=bp.client))

@@ -49,15 +49,18 @@ __all__ = [
 ]
 
 
-def step_target(states: list[np.ndarray], actions: list[np.ndarray], scale: float) -> np.ndarray:
+def step_target(
+    states: list[np.ndarray], actions: list[np.ndarray], scale: float, dim: int = len(STEP_STATE)
+) -> np.ndarray:
     """The state the step objective aims for: the mean recorded (mirrored) step state of
     steps taken at scales within 0.1 of ``scale`` (all steps if none), heading 0.
 
     A walking robot's torso never settles at zero tilt; aiming for zero would make the
     search fight the gait itself. Heading is the exception: the walk should go straight.
+    ``dim``: the state's size when nothing is recorded.
     """
     if not states:
-        return np.zeros(len(STEP_STATE))
+        return np.zeros(dim)
     S = np.vstack(states)
     A = np.vstack(actions)
     near = np.abs(A[:, -1] - scale) <= 0.1 + 1e-9
@@ -78,12 +81,15 @@ def upgrade_step_actions(A: np.ndarray) -> np.ndarray:
 def mirror_state(s: np.ndarray, m: float) -> np.ndarray:
     """A step state seen from the stance side: lateral parts × m (+1 left, −1 right).
 
-    The last entry (``load_left`` raw) becomes the stance foot's share.
+    ``load_left`` (raw) becomes the stance foot's share, and the :data:`SERVO_STATE`
+    entries, if any (raw: left, right), the stance leg's first.
     """
     out = np.array(s, dtype=float)
-    out[..., LATERAL] *= m
+    out[..., : len(LATERAL)][..., LATERAL] *= m
     if m < 0:
         out[..., 6] = 1.0 - out[..., 6]
+        if out.shape[-1] > len(STEP_STATE):
+            out[..., [-2, -1]] = out[..., [-1, -2]]
     return out
 
 
@@ -95,7 +101,7 @@ class StepController:
         model: a fitted step model (``None``: nominal channels, plus exploration).
         rng: exploration noise source (``None``: no exploration).
         explore: noise amplitude, a fraction of ``c_max``; scale: the stride scale (an
-            input of the step model); target: ``(8,)`` mirrored step state the objective
+            input of the step model); target: ``(d,)`` mirrored step state the objective
             pulls towards (see :func:`step_target`).
     """
 
@@ -112,7 +118,8 @@ class StepController:
         limits: np.ndarray | None = None,
     ):
         self.config, self.n, self.ds, self.scale = config, n_ticks, ds, scale
-        self.target = np.zeros(len(STEP_STATE)) if target is None else np.asarray(target, float)
+        dim = len(config.state_names)
+        self.target = np.zeros(dim) if target is None else np.asarray(target, float)
         self.model, self.rng, self.explore = model, rng, explore
         self.mask = np.array([c in config.channels for c in STEP_CHANNELS], dtype=float)
         self.c_max = np.asarray(config.c_max, dtype=float) * self.mask
@@ -157,7 +164,7 @@ class StepController:
         seq[:, 0, :-1] = cand
         seq[:, :, -1] = self.scale  # the model also sees the stride scale
         pred = self.model.rollout_members(s, s_prev, seq, c_prev)  # (E, M, H, ds)
-        w = np.asarray(cfg.weights, dtype=float)
+        w = cfg.state_weights
         scale = np.where(self.c_max > 0, self.c_max, 1.0)
         cost = stability_cost(pred - self.target, w).sum(axis=-1)  # (E, M)
         cost = cost + cfg.effort * np.sum((cand / scale) ** 2, 1)
@@ -177,11 +184,12 @@ class StepController:
 
     # -- task offsets ---------------------------------------------------------
     def episode(self) -> tuple[np.ndarray, np.ndarray]:
-        """The recorded steps for training: states ``(K, 8)`` and actions
+        """The recorded steps for training: states ``(K, len(config.state_names))`` and actions
         ``(K, len(STEP_CHANNELS) + 1)`` (channels and the scale); K may be 0."""
         k = min(len(self.states), len(self.actions))
         if k == 0:  # the robot fell before its first step decision
-            return np.zeros((0, len(STEP_STATE))), np.zeros((0, len(STEP_CHANNELS) + 1))
+            dim = len(self.config.state_names)
+            return np.zeros((0, dim)), np.zeros((0, len(STEP_CHANNELS) + 1))
         acts = np.c_[np.asarray(self.actions[:k]).reshape(k, -1), np.full(k, self.scale)]
         return np.asarray(self.states[:k]).reshape(k, -1), acts
 

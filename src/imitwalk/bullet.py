@@ -9,16 +9,9 @@ on it (``imitwalk learn --set engine=bullet --set retarget.search_config.engine=
 The robot is the MuJoCo model written out as URDF (:func:`imitwalk.robots.urdf.to_urdf`):
 the same masses, inertias, joint axes, ranges and collision shapes. The servos are the
 MJCF's position actuators, with ``kp``, ``kv``, the joint damping and the torque limit read
-from the compiled model, applied as torques at 5 kHz. Bullet has no rotor inertia
-(MuJoCo's ``armature``), and without it an explicit PD rings or diverges on the light
-links (at 5 kHz ``kv·dt / M_jj`` is 1.7 at the ankle roll and 1.6 at the hands' twist,
-``M_jj`` being the joint's own inertia from Bullet's mass matrix; at 1 kHz the robot
-blew up). So each servo is integrated
-implicitly, one joint at a time (the diagonal form of Tan et al. 2011's stable PD):
-``τ = (kp e − D q̇ − r τ_o) / (1 + r)``, with ``e = q* − q``, ``D = kp dt + kv + d``,
-``r = D dt / M_jj`` and ``τ_o`` the joint's other torques over the last step (measured
-from its acceleration, see :data:`SMOOTH`), which keeps the static stiffness ``kp``
-exact. Joint friction loss is left out.
+from the compiled model, applied as torques at 5 kHz and integrated implicitly, one joint
+at a time (:class:`imitwalk.servo.StablePD`: Bullet has no rotor inertia, and an explicit PD
+diverges on the light links). Joint friction loss is left out.
 
 The sensors are the robot's: the gyro at its site; the accelerometer at the same site,
 from the site's velocity change over the control period (averaged over 10 ms, where
@@ -37,14 +30,10 @@ import pybullet as pb
 
 from imitwalk.robots import Robot
 from imitwalk.robots.urdf import urdf_file
+from imitwalk.servo import StablePD
 from imitwalk.simtypes import Observation, SimOptions, checked_targets, jitter_draws
 
 __all__ = ["BulletPlant"]
-
-#: Weight of the newest estimate in the running mean of each joint's "other torques"
-#: (gravity, contacts, the rest of the body), per physics step. Unsmoothed (1) the
-#: estimate made the hands' twist (``M_jj`` ≈ 6e-6 kg m²) chatter at the torque limit.
-SMOOTH = 0.5
 
 
 def _rot(quat_xyzw) -> np.ndarray:
@@ -104,9 +93,9 @@ class BulletPlant:
         self._dof = [joint[j] for j in robot.mj_joints]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
         act = np.array([act_for[j] for j in jid])
-        self.kp = robot.kp * kps
-        self.kd = -m.actuator_biasprm[act, 2] + m.dof_damping[m.jnt_dofadr[jid]]
+        kd = -m.actuator_biasprm[act, 2] + m.dof_damping[m.jnt_dofadr[jid]]
         self.limit = robot.torque_limit
+        self.servo = StablePD(robot.kp * kps, kd, self.limit, self.dt)
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
@@ -127,8 +116,6 @@ class BulletPlant:
         self._noise = np.random.default_rng(opt.seed + 7919)
         self._queue: deque[np.ndarray] = deque()
         self._cmd = robot.stand.copy()
-        self._tau = np.zeros(len(self._dof))
-        self._qd, self._other = np.zeros(len(self._dof)), np.zeros(len(self._dof))
         self._accel = np.zeros(3)
         self._imu_now = (np.zeros(3), np.zeros(3), np.eye(3))  # set by reset() and step()
         self.time = 0.0
@@ -200,8 +187,7 @@ class BulletPlant:
         self._queue = deque([self._cmd.copy()] * opt.servo_delay)
         self._imu_now = self._site_velocity(*self._imu[:2])  # (v, ω, R) of the IMU site
         self._accel = np.zeros(3)
-        self._tau, self._qd = np.zeros(len(self._dof)), np.zeros(len(self._dof))
-        self._other = np.zeros(len(self._dof))
+        self.servo.reset()
         self.time = 0.0
         self.fell, self.fall_time = False, None
         return self.observe()
@@ -214,22 +200,14 @@ class BulletPlant:
         cid = {"physicsClientId": c}
         self._queue.append(self._cmd)
         target = self._queue.popleft() * self._sign
-        dt, kp, kd = self.dt, self.kp, self.kd
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
         mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
         mjj = mass[6 + np.array(self._dof)]  # each joint's own inertia [kg m²]
-        damp = kp * dt + kd
-        ratio = damp * dt / mjj
         for _ in range(self.substeps):
             states = pb.getJointStates(self.body, self._dof, physicsClientId=c)
             q = np.array([s[0] for s in states])
             qd = np.array([s[1] for s in states])
-            # the other torques on each joint over the last step (gravity, contacts, ...)
-            now = (qd - self._qd) / dt * mjj - self._tau
-            self._other = other = self._other + SMOOTH * (now - self._other)
-            tau = (kp * (target - q) - damp * qd - ratio * other) / (1.0 + ratio)
-            self._tau, self._qd = np.clip(tau, -self.limit, self.limit), qd
-            tau = self._tau.tolist()
+            tau = self.servo.torque(target, q, qd, mjj).tolist()
             pb.setJointMotorControlArray(self.body, self._dof, pb.TORQUE_CONTROL, forces=tau, **cid)
             t0 = opt.push_time
             if opt.push_duration > 0 and t0 <= self.time < t0 + opt.push_duration:
@@ -290,7 +268,7 @@ class BulletPlant:
 
     def torques(self) -> np.ndarray:
         """``(n,)`` each servo's output torque over the last physics step [Nm]."""
-        return self._tau * self._sign
+        return self.servo.tau * self._sign
 
     def torque_limits(self) -> np.ndarray:
         """``(n,)`` each servo's torque limit [Nm]."""

@@ -114,7 +114,14 @@ def retarget(args: argparse.Namespace) -> int:
         shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
         progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
 
+    sc = cfg.search_config
+    if cfg.search and sc.cadences:
+        rates = ", ".join(f"{r:g}" for r in sc.cadences)
+        n, secs = sc.cadence_models, sc.cadence_seconds
+        progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
     res = run(motion, robot, cfg, progress=report)
+    for row in res.reference.search.get("cadence", {}).get("trials", []):
+        progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = args.robot
     res.reference.settings["joint_map"] = args.joint_map
     res.reference.save(args.out)

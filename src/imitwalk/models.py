@@ -155,7 +155,11 @@ def build_policy(
             rng=rng,
             explore=config.step.explore * explore,
             scale=scale,
-            target=step_target(*models.step_data, scale) if models.step is not None else None,
+            target=(
+                step_target(*models.step_data, scale, len(config.step.state_names))
+                if models.step is not None
+                else None
+            ),
             limits=step_limits(models, config),
         )
     return WalkPolicy(

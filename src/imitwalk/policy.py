@@ -21,8 +21,10 @@ import numpy as np
 
 from imitwalk.balance import StepController
 from imitwalk.controller import ActionSelector
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.estimator import StateEstimator
 from imitwalk.gait import GaitModel
+from imitwalk.stepconfig import LAG_JOINTS
 
 __all__ = ["WalkPolicy"]
 
@@ -80,6 +82,16 @@ class WalkPolicy:
         turning = bool(ref.plan) and abs(ref.motion_at(scale)[2]) > 0.0
         self._cmd_heading = ref.plan_at(scale)["path"][:, 2] if turning else None
         self._cmd_turn = float(ref.motion_at(scale)[2]) if turning else 0.0
+        # the servo state: ankle-pitch tracking errors, per step, of the last two steps
+        self._lag = None
+        if steps is not None and steps.config.servo_state:
+            names = tuple(ref.joint_names)
+            for j in LAG_JOINTS:
+                if j not in names:
+                    raise unknown_name("joint (for step.servo_state)", j, names, ConfigError)
+            self._lag = [names.index(j) for j in LAG_JOINTS]
+        self._lag_now, self._lag_sum, self._lag_steps = np.zeros(2), np.zeros(2), [np.zeros(2)]
+        self._last: np.ndarray | None = None  # the targets last commanded
 
     @property
     def first_loop_tick(self) -> int:
@@ -99,6 +111,13 @@ class WalkPolicy:
         return est.gyro.copy()
 
     def __call__(self, k: int, obs) -> np.ndarray:
+        if self._lag is not None and self._last is not None:  # the servos' lag, measured
+            self._lag_now = self._last[self._lag] - np.asarray(obs.joints)[self._lag]
+        q = self._targets(k, obs)
+        self._last = q
+        return q
+
+    def _targets(self, k: int, obs) -> np.ndarray:
         est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
         if self.steps is None or k < self._clock0:
             return self._at(k, est)
@@ -176,12 +195,17 @@ class WalkPolicy:
         h0 = self.commanded_heading(v)
         rate = (self.commanded_heading(v + 1) - h0) / self.gait.ref.dt
         self._gyro_sum += np.r_[est.gyro - [0.0, 0.0, rate], est.cop_x]
+        self._lag_sum += self._lag_now
         self._gyro_n += 1
         half = self.n / 2.0
         while j >= self._step_k * half:  # a step boundary (heel strike): decide
             mean = self._gyro_sum / max(self._gyro_n, 1)  # gyro (3) and cop_x over the step
             heading = est.heading - h0
             state = np.array([est.roll, est.pitch, heading, *mean[:3], est.load_left, mean[3]])
+            if self._lag is not None:  # mean over the last two steps: one gait cycle
+                self._lag_steps = [self._lag_steps[-1], self._lag_sum / max(self._gyro_n, 1)]
+                state = np.r_[state, 0.5 * (self._lag_steps[0] + self._lag_steps[1])]
+                self._lag_sum = np.zeros(2)
             self.steps.decide(state, self._step_k)
             self._step_k += 1
             self._gyro_sum, self._gyro_n = np.zeros(4), 0

@@ -14,7 +14,16 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 
-__all__ = ["ALWAYS_DRAWN", "LATERAL", "STEP_CHANNELS", "STEP_STATE", "TIME", "StepConfig"]
+__all__ = [
+    "ALWAYS_DRAWN",
+    "LAG_JOINTS",
+    "LATERAL",
+    "SERVO_STATE",
+    "STEP_CHANNELS",
+    "STEP_STATE",
+    "TIME",
+    "StepConfig",
+]
 
 #: The channels, in the order of every channel vector (see :mod:`imitwalk.balance`).
 STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
@@ -36,6 +45,13 @@ STEP_STATE = (
 )
 #: The :data:`STEP_STATE` entries whose sign flips when a right step is mirrored.
 LATERAL = np.array([1, 0, 1, 1, 0, 1, 0, 0], dtype=bool)
+#: Step state added by ``StepConfig.servo_state``: each ankle-pitch servo's mean tracking
+#: error (commanded − measured, from the joint encoders) over the last gait cycle [rad],
+#: the coming stance leg's first. Under load a softer servo lags more, so these tell the
+#: step model which kind of robot it is on. (Raw order: left, right.)
+SERVO_STATE = ("ankle_lag_stance", "ankle_lag_other")
+#: The joints whose tracking error :data:`SERVO_STATE` measures (left, right).
+LAG_JOINTS = ("l_ankle_pitch", "r_ankle_pitch")
 
 
 @dataclass(frozen=True)
@@ -67,6 +83,8 @@ class StepConfig:
         gain: the channel values the search chooses are multiplied by this (a trust
             factor on the model's corrections: 1 applies them as predicted, 0 turns them
             off). The learner can pick it from measured trials (``LearnConfig.gains``).
+        servo_state: add :data:`SERVO_STATE` to the step state (off by default). It is
+            not in the objective (weight 0); the step model may use it to predict.
     """
 
     channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
@@ -81,6 +99,19 @@ class StepConfig:
     ensemble: int = 1
     margin: float = 0.0
     gain: float = 1.0
+    servo_state: bool = False
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The step state's names, in order."""
+        return STEP_STATE + (SERVO_STATE if self.servo_state else ())
+
+    @property
+    def state_weights(self) -> np.ndarray:
+        """``(len(state_names),)`` λ of the step objective (0 for :data:`SERVO_STATE`)."""
+        w = np.zeros(len(self.state_names))
+        w[: len(STEP_STATE)] = self.weights
+        return w
 
     def __post_init__(self):
         for c in self.channels:
@@ -99,5 +130,10 @@ class StepConfig:
             raise ConfigError(f"step.c_max for time={self.c_max[TIME]}: expected 0 <= c < 0.5")
         if not 0.0 <= self.margin < 1.0:
             raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
+        if len(self.weights) != len(STEP_STATE):
+            raise ConfigError(
+                f"step.weights has {len(self.weights)} values: expected one per state entry of "
+                f"{', '.join(STEP_STATE)}"
+            )
         if not 0.0 <= self.gain <= 2.0:
             raise ConfigError(f"step.gain={self.gain}: expected 0 <= gain <= 2")

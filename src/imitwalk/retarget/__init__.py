@@ -20,7 +20,7 @@ from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
-from imitwalk.retarget.search import SearchConfig, search_params
+from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
@@ -55,7 +55,8 @@ class RetargetConfig:
             (:class:`~imitwalk.retarget.command.GaitCommand`; default straight, level).
         cadence: play the loop this many times as fast as the human walked
             (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
-            the human's cadence). 1: the human's own.
+            the human's cadence). 1: the human's own. To have it searched instead, give
+            ``search_config.cadences`` (:func:`~imitwalk.retarget.search.search_cadence`).
     """
 
     CHOICES: ClassVar[dict] = {"mapping": MAPPINGS}
@@ -105,10 +106,12 @@ class RetargetResult:
             "params": ref.params,
         }
         out.update({k: v for k, v in ref.checks.items() if k != "scale"})
-        if ref.search:
+        if ref.search.get("best"):
             s = ref.search
             out["search"] = {k: s[k] for k in ("evaluations", "sim_seconds", "wall_seconds")}
             out["search"]["best_score"] = s["best"]["score"]
+        if "cadence" in ref.search:
+            out["cadence_search"] = ref.search["cadence"]
         return out
 
 
@@ -134,6 +137,9 @@ def retarget(
     t0 = time.perf_counter()
     if cfg.mapping == "paper" and not cfg.command.straight:
         raise ConfigError("a turn, sidestep, stride fraction or slope needs mapping=walkable")
+    searched_cadence = cfg.search and cfg.mapping == "walkable" and bool(cfg.search_config.cadences)
+    if searched_cadence and cfg.cadence != 1.0:
+        raise ConfigError("give either cadence or search_config.cadences, not both")
     if cfg.mapping == "paper":
         ref = build_paper(motion, template, robot, cfg.scales, dt)
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
@@ -164,5 +170,8 @@ def retarget(
         "motion_fps": motion.fps,
         "filled": list(motion.filled),
     }
-    ref = with_cadence(ref, cfg.cadence)
+    rate = cfg.cadence
+    if searched_cadence:
+        rate, ref.search["cadence"] = search_cadence(ref, robot, cfg.search_config)
+    ref = with_cadence(ref, rate)
     return RetargetResult(ref, motion.n_frames, motion.fps, template, frames, seconds)

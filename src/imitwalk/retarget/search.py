@@ -6,6 +6,11 @@ double support, lean, width) are chosen by the cross-entropy method over open-lo
 rollouts: each candidate reference is solved by IK at a few stride scales and played
 on the nominal robot and on training perturbations (never an evaluation robot). A
 rollout scores ``alive fraction + ½·min(progress ratio, 1) − ½·min(|yaw drift| / 45°, 1)``.
+
+The cadence can be searched too (``SearchConfig.cadences``, off by default):
+:func:`search_cadence` plays the searched reference at full stride at each candidate rate
+(:func:`~imitwalk.retarget.cadence.with_cadence`) on more training robots, for longer, and
+keeps the rate with the fewest falls.
 """
 
 from __future__ import annotations
@@ -19,16 +24,18 @@ from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed, train_seeds
+from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK
 from imitwalk.retarget.plan import GaitParams
+from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
 from imitwalk.sim import SimOptions, make_plant, playback
 from imitwalk.simtypes import ENGINES
 
-__all__ = ["BOUNDS", "SearchConfig", "search_params"]
+__all__ = ["BOUNDS", "SearchConfig", "search_cadence", "search_params"]
 
 #: Search range of each reference parameter.
 BOUNDS: dict[str, tuple[float, float]] = {
@@ -54,6 +61,11 @@ class SearchConfig:
         seconds: simulated time per rollout [s]; seed: the search's random seed.
         workers: parallel processes (``None``: one per core).
         engine: the physics engine of the trials (:data:`imitwalk.simtypes.ENGINES`).
+        cadences: candidate cadence rates (0.5–2; 1: the human's) for
+            :func:`search_cadence`, tried after the parameters; empty: not searched.
+        cadence_models, cadence_seconds: robots (the nominal one + training
+            perturbations, with the evaluation's initial push) and simulated time [s] per
+            cadence trial, at the largest of ``scales``.
     """
 
     generations: int = 5
@@ -65,10 +77,18 @@ class SearchConfig:
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"
+    cadences: tuple[float, ...] = ()
+    cadence_models: int = 24
+    cadence_seconds: float = 20.0
 
     def __post_init__(self):
         if self.engine not in ENGINES:
             raise unknown_name("engine", self.engine, ENGINES, ConfigError)
+        for r in self.cadences:
+            if not 0.5 <= r <= 2.0:
+                raise ConfigError(f"search_config.cadences: {r} is not a rate in 0.5..2")
+        if self.cadences and (self.cadence_models < 1 or self.cadence_seconds <= 0):
+            raise ConfigError("search_config.cadence_models must be >= 1 and cadence_seconds > 0")
 
 
 _IK: dict = {}
@@ -167,3 +187,60 @@ def search_params(
         "history": history,
     }
     return GaitParams(**best["params"]), report
+
+
+def _cadence_trial(job) -> dict:
+    ref, robot, rate, seed, scale, seconds, base, engine = job
+    ref = with_cadence(ref, rate)
+    q = ref.trajectory(scale, seconds)
+    opts = perturbed(seed, ref.sim_options(base), disturbance=seed != 0)
+    ro = playback(make_plant(robot, opts, engine), q, q0=q[0])
+    track = ref.track(scale, ro.seconds)
+    m = walk_metrics(ro, ref.expected_distance(scale, ro.seconds), track=track)
+    return {"fell": m.fell, "yaw_drift_deg": m.yaw_drift_deg, "progress_ratio": m.progress_ratio}
+
+
+def search_cadence(
+    ref: Reference, robot: Robot, config: SearchConfig, base: SimOptions | None = None
+) -> tuple[float, dict]:
+    """Pick the rate of ``config.cadences`` at which ``ref`` falls least, open loop.
+
+    Each rate is played at the largest search scale on ``config.cadence_models`` training
+    robots (the same robots for every rate) for ``config.cadence_seconds``. The fewest
+    falls wins; a tie goes to the rate nearest the human's (1), then to the smaller mean
+    |yaw drift|.
+
+    Returns:
+        the rate (relative to ``ref``'s cadence) and a JSON-able report of every trial.
+    """
+    scale = max(config.scales)
+    seeds = train_seeds(config.cadence_models)
+    jobs = [
+        (ref, robot, r, s, scale, config.cadence_seconds, base, config.engine)
+        for r in config.cadences
+        for s in seeds
+    ]
+    t0 = time.perf_counter()
+    res = run_parallel(_cadence_trial, jobs, config.workers)
+    rows = []
+    for i, rate in enumerate(config.cadences):
+        part = res[i * len(seeds) : (i + 1) * len(seeds)]
+        rows.append(
+            {
+                "rate": float(rate),
+                "falls": int(sum(r["fell"] for r in part)),
+                "robots": len(part),
+                "mean_abs_yaw_deg": float(np.mean([abs(r["yaw_drift_deg"]) for r in part])),
+                "mean_progress_ratio": float(np.mean([r["progress_ratio"] for r in part])),
+            }
+        )
+    best = min(rows, key=lambda r: (r["falls"], abs(r["rate"] - 1.0), r["mean_abs_yaw_deg"]))
+    report = {
+        "scale": scale,
+        "seconds": config.cadence_seconds,
+        "seeds": list(seeds),
+        "trials": rows,
+        "rate": best["rate"],
+        "wall_seconds": time.perf_counter() - t0,
+    }
+    return best["rate"], report
