@@ -4,7 +4,8 @@ Plays a reference open loop at one scale on evaluation robots 0..N-1 (as ``imitw
 evaluate`` draws them: masses, friction, servo stiffness, initial push) and relates each
 robot's draws to whether it fell: the correlation of each joint's servo-stiffness factor
 (and of the friction) with falling, and the 5-fold cross-validated ROC AUC of a logistic
-model of falling on all the draws (0.5: the draws do not tell; 1: they decide). Prints JSON.
+model of falling on the servo factors and the friction (0.5: they do not tell; 1: they
+decide). Prints JSON.
 
 Usage: ``python bench/servo_falls.py REFERENCE.npz [--robots 160] [--scale 1.0]
 [--seconds 30]``

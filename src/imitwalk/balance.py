@@ -25,8 +25,10 @@ re-solves the reference's task-space plan with these offsets
 (:class:`imitwalk.retarget.online.OnlineIK`). The step state (mirrored) is torso roll,
 pitch, heading, the mean gyro over the step, the stance foot's share of the load and the
 mean front/rear balance of the sole forces over the step — all from the robot's own
-sensors. The settings, and the names of the channels and states, are in
-:mod:`imitwalk.stepconfig`.
+sensors; with ``step.servo_state``, also each ankle-pitch servo's mean tracking error over
+the last gait cycle, from the joint encoders (measured by
+:class:`imitwalk.policy.WalkPolicy`). The settings, and the names of the channels and
+states, are in :mod:`imitwalk.stepconfig`.
 """
 
 from __future__ import annotations
