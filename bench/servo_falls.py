@@ -21,22 +21,11 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import cross_val_score
 
-from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed
+from imitwalk.playback import play_reference
 from imitwalk.retarget import Reference
 from imitwalk.robots import load_robot
-from imitwalk.sim import make_plant, playback
 from imitwalk.simtypes import jitter_draws
-
-
-def _one(job) -> tuple[bool, float, list[float]]:
-    path, seed, scale, seconds = job
-    ref, robot = Reference.load(path), load_robot("hoap2")
-    opts = perturbed(seed, ref.sim_options(None), disturbance=seed != 0)
-    q = ref.trajectory(scale, seconds)
-    ro = playback(make_plant(robot, opts), q, q0=q[0])
-    kp = jitter_draws(opts, robot.compile().nbody, robot.joint_names)[1]
-    return bool(ro.fell), float(opts.friction or 1.0), kp.tolist()
 
 
 def main() -> None:
@@ -47,12 +36,15 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=30.0)
     args = ap.parse_args()
     t0 = time.perf_counter()
-    jobs = [(args.reference, s, args.scale, args.seconds) for s in range(args.robots)]
-    res = run_parallel(_one, jobs)
-    fell = np.array([r[0] for r in res], dtype=float)
-    friction = np.array([r[1] for r in res])
-    kp = np.array([r[2] for r in res])
-    names = load_robot("hoap2").joint_names
+    ref, robot = Reference.load(args.reference), load_robot("hoap2")
+    seeds = range(args.robots)
+    runs = play_reference(ref, robot, args.scale, args.seconds, seeds, disturbance=True)
+    fell = np.array([r.metrics.fell for r in runs], dtype=float)
+    # each robot's draws, as play_reference drew them
+    opts = [perturbed(s, ref.sim_options(None), disturbance=s != 0) for s in seeds]
+    friction = np.array([o.friction or 1.0 for o in opts])
+    nbody, names = robot.compile().nbody, robot.joint_names
+    kp = np.array([jitter_draws(o, nbody, names)[1] for o in opts])
 
     def corr(x: np.ndarray) -> float:
         return float(np.corrcoef(x, fell)[0, 1]) if x.std() > 0 and fell.std() > 0 else 0.0

@@ -67,6 +67,7 @@ def play_reference(
     base: SimOptions | None = None,
     workers: int | None = None,
     engine: str = "mujoco",
+    disturbance: bool = False,
 ) -> list[ModelRun]:
     """Play ``ref`` at ``scale`` open loop for ``seconds`` on the robots ``seeds``.
 
@@ -77,10 +78,13 @@ def play_reference(
         base: options every run starts from (rates, noise, slope ...).
         workers: parallel processes (default: one per core; 1 runs in this process).
         engine: physics engine, one of :data:`imitwalk.sim.ENGINES`.
+        disturbance: give the perturbed robots the evaluation's small initial push too.
     """
     q = ref.trajectory(scale, seconds)
     base = ref.sim_options(base)  # on the ground the gait was built for
-    jobs = [(robot, q, q[0], perturbed(s, base), _Expected(ref, scale), s, engine) for s in seeds]
+    expected = _Expected(ref, scale)
+    opts = [perturbed(s, base, disturbance=disturbance and s != 0) for s in seeds]
+    jobs = [(robot, q, q[0], o, expected, s, engine) for s, o in zip(seeds, opts, strict=True)]
     return run_parallel(_one, jobs, workers)
 
 

@@ -189,17 +189,6 @@ def search_params(
     return GaitParams(**best["params"]), report
 
 
-def _cadence_trial(job) -> dict:
-    ref, robot, rate, seed, scale, seconds, base, engine = job
-    ref = with_cadence(ref, rate)
-    q = ref.trajectory(scale, seconds)
-    opts = perturbed(seed, ref.sim_options(base), disturbance=seed != 0)
-    ro = playback(make_plant(robot, opts, engine), q, q0=q[0])
-    track = ref.track(scale, ro.seconds)
-    m = walk_metrics(ro, ref.expected_distance(scale, ro.seconds), track=track)
-    return {"fell": m.fell, "yaw_drift_deg": m.yaw_drift_deg, "progress_ratio": m.progress_ratio}
-
-
 def search_cadence(
     ref: Reference, robot: Robot, config: SearchConfig, base: SimOptions | None = None
 ) -> tuple[float, dict]:
@@ -213,25 +202,34 @@ def search_cadence(
     Returns:
         the rate (relative to ``ref``'s cadence) and a JSON-able report of every trial.
     """
+    from imitwalk.playback import play_reference  # it imports this package
+
     scale = max(config.scales)
     seeds = train_seeds(config.cadence_models)
-    jobs = [
-        (ref, robot, r, s, scale, config.cadence_seconds, base, config.engine)
-        for r in config.cadences
-        for s in seeds
-    ]
     t0 = time.perf_counter()
-    res = run_parallel(_cadence_trial, jobs, config.workers)
     rows = []
-    for i, rate in enumerate(config.cadences):
-        part = res[i * len(seeds) : (i + 1) * len(seeds)]
+    for rate in config.cadences:
+        runs = [
+            r.metrics
+            for r in play_reference(
+                with_cadence(ref, rate),
+                robot,
+                scale,
+                config.cadence_seconds,
+                seeds,
+                base,
+                config.workers,
+                config.engine,
+                disturbance=True,
+            )
+        ]
         rows.append(
             {
                 "rate": float(rate),
-                "falls": int(sum(r["fell"] for r in part)),
-                "robots": len(part),
-                "mean_abs_yaw_deg": float(np.mean([abs(r["yaw_drift_deg"]) for r in part])),
-                "mean_progress_ratio": float(np.mean([r["progress_ratio"] for r in part])),
+                "falls": int(sum(m.fell for m in runs)),
+                "robots": len(runs),
+                "mean_abs_yaw_deg": float(np.mean([abs(m.yaw_drift_deg) for m in runs])),
+                "mean_progress_ratio": float(np.mean([m.progress_ratio for m in runs])),
             }
         )
     best = min(rows, key=lambda r: (r["falls"], abs(r["rate"] - 1.0), r["mean_abs_yaw_deg"]))
