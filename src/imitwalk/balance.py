@@ -129,6 +129,7 @@ class StepController:
         # the search stays where the model has seen data; exploration may go to the limits
         self.box = self.c_max if limits is None else np.minimum(self.c_max, limits)
         self._drawn = (np.arange(len(STEP_CHANNELS)) < ALWAYS_DRAWN) | (self.mask > 0)
+        self.offset = config.offset_vector * self.mask  # the nominal channel values
         self.states: list[np.ndarray] = []  # mirrored step states s_k
         self.actions: list[np.ndarray] = []  # channel values c_k (mirrored coordinates)
         self.predicted: list[float] = []
@@ -141,10 +142,11 @@ class StepController:
         m = 1.0 if k % 2 == 0 else -1.0  # even steps: left stance (ψ ∈ [0, ½))
         s = mirror_state(state_raw, m)
         self.states.append(s)
-        c = np.zeros(len(STEP_CHANNELS))
+        base = self.offset
+        c = base.copy()
         if self.model is not None and len(self.states) >= 2 and len(self.actions) >= 1:
             c, pred = self._search(s, self.states[-2], np.r_[self.actions[-1], self.scale])
-            c = self.config.gain * c
+            c = base + self.config.gain * (c - base)
             self.predicted.append(pred)
         if self.rng is not None and self.explore > 0:
             noise = np.zeros(len(c))
@@ -161,16 +163,20 @@ class StepController:
         cand = np.zeros((cfg.candidates, len(STEP_CHANNELS)))
         d = self._drawn
         cand[:, d] = rng.uniform(lo[d], self.box[d], (cfg.candidates, int(d.sum())))
-        cand = np.vstack([np.zeros(len(STEP_CHANNELS)), cand])  # (M, channels)
+        base = self.offset
+        if base.any():  # the box is centred on the offset, within the channels' limits
+            cand = np.clip(base + cand, self.c_min, self.c_max)
+        cand = np.vstack([base, cand])  # (M, channels); the first: the nominal
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand
+        seq[:, 1:, :-1] = base  # later steps: the nominal channels
         seq[:, :, -1] = self.scale  # the model also sees the stride scale
         pred = self.model.rollout_members(s, s_prev, seq, c_prev)  # (E, M, H, ds)
         w = cfg.state_weights
         scale = np.where(self.c_max > 0, self.c_max, 1.0)
         cost = stability_cost(pred - self.target, w).sum(axis=-1)  # (E, M)
-        cost = cost + cfg.effort * np.sum((cand / scale) ** 2, 1)
-        # each member's predicted gain over the nominal (zero) channels; the worst decides
+        cost = cost + cfg.effort * np.sum(((cand - base) / scale) ** 2, 1)
+        # each member's predicted gain over the nominal channels; the worst decides
         worst = (cost - cost[:, :1]).max(axis=0)
         best = int(np.argmin(worst))
         if worst[best] > -cfg.margin * cost[:, 0].mean():  # not a clear enough gain

@@ -215,6 +215,8 @@ def learn(args: argparse.Namespace) -> int:
         "gain_trials",
         "cadence",
         "cadence_trials",
+        "channel_offset",
+        "offset_trials",
     )
     out = {k: summary[k] for k in keys}
     out["run_dir"] = str(rd.path)

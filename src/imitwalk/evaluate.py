@@ -46,6 +46,8 @@ class LearnedGait:
     def __init__(self, ref: Reference, config: LearnConfig, data: dict, metrics: dict):
         gain = metrics.get("channel_gain", config.step.gain)  # picked by the gain trials
         config = replace(config, step=replace(config.step, gain=float(gain)))
+        for channel, value in (metrics.get("channel_offset") or {}).items():  # the trials'
+            config = replace(config, offset_channel=channel).with_offset(value)
         self.ref, self.config, self.metrics = ref, config, metrics
         self.scale = float(metrics["scale_reached"]) or config.schedule.start
         self.cadence = float(metrics.get("cadence", 1.0))  # picked by the cadence trials

@@ -20,7 +20,7 @@ from typing import ClassVar
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.gait import GaitConfig
 from imitwalk.simtypes import ENGINES
-from imitwalk.stepconfig import StepConfig
+from imitwalk.stepconfig import STEP_CHANNELS, StepConfig
 
 __all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
 
@@ -104,6 +104,12 @@ class LearnConfig:
             :func:`imitwalk.retarget.cadence.with_cadence`) tried after the gains, with
             the gain kept, on the same robots; list the human's own rate, 1, first.
             Empty: the reference's cadence.
+        offsets: candidate constant values of the channel ``offset_channel`` (its
+            ``step.offset``), tried on the ``gain_robots`` when the schedule would stop at
+            a scale; if another value measures better there, the schedule goes on at that
+            scale with it. The scale reached gets the same trials before the gain trials
+            (once per scale). Empty: off.
+        offset_channel: the channel those offsets are for (one of ``step.channels``).
         seed: random seed; workers: parallel processes (``None``: one per core).
         engine: the physics engine the robot learns on (:data:`imitwalk.simtypes.ENGINES`;
             ``bullet`` is about ten times slower than MuJoCo).
@@ -120,6 +126,8 @@ class LearnConfig:
     train_friction: tuple[float, float] = (0.7, 1.0)
     gains: tuple[float, ...] = ()
     cadences: tuple[float, ...] = ()
+    offsets: tuple[float, ...] = ()
+    offset_channel: str = "dx"
     gain_robots: int = 12
     gain_seconds: float = 24.0
     seed: int = 0
@@ -144,8 +152,25 @@ class LearnConfig:
             raise ConfigError(
                 f"train_friction={self.train_friction}: expected two values 0 < low <= high <= 3"
             )
-        if (self.gains or self.cadences) and self.gain_robots < 1:
+        if self.offsets:
+            if self.offset_channel not in self.step.channels:
+                raise unknown_name(
+                    "offset_channel", self.offset_channel, self.step.channels, ConfigError
+                )
+            for v in self.offsets:  # each candidate must be a valid step.offset
+                self._step_with_offset(v)
+        if (self.gains or self.cadences or self.offsets) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
+
+    def with_offset(self, value: float | None) -> LearnConfig:
+        """These settings with ``step.offset`` set to ``value`` on ``offset_channel``
+        (``None``: unchanged)."""
+        return self if value is None else replace(self, step=self._step_with_offset(value))
+
+    def _step_with_offset(self, value: float) -> StepConfig:
+        off = self.step.offset_vector
+        off[STEP_CHANNELS.index(self.offset_channel)] = value
+        return replace(self.step, offset=tuple(float(v) for v in off))
 
 
 VARIANTS: dict[str, LearnConfig] = {

@@ -5,7 +5,10 @@ for the extended variant training perturbations never used for evaluation — ne
 every iteration with ``fresh_robots``), records the
 sensory-motor data, refits the models on everything recorded so far and moves along the
 scale schedule: a scale is passed when its last ``confirm`` iterations (no exploration)
-walk without a fall on every training robot. When the schedule stops, a few
+walk without a fall on every training robot. With ``offsets``, a scale where the schedule
+would stop first gets trials of a constant channel offset (:mod:`imitwalk.trust`); if
+another offset measures better there, the schedule goes on with it (the scale reached
+gets the trials too). When it stops, a few
 consolidation iterations at the scale reached add on-policy data where the gait will be
 used (their falls are logged; they do not change the scale reached). With ``gains``, the
 channel-gain trials then decide how much of the learned correction to apply, and with
@@ -23,54 +26,21 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from imitwalk.config import from_dict, to_dict
-from imitwalk.controller import stability_cost
+from imitwalk.episode import run_episode
 from imitwalk.errors import RunError
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
-from imitwalk.models import build_policy, fit_models, stack_episodes, unstack_episodes
+from imitwalk.models import fit_models, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
 from imitwalk.perturb import train_seeds, trial_seeds
 from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
+from imitwalk.stepconfig import STEP_CHANNELS
 from imitwalk.trust import LABELS, tune_gain
 
 __all__ = ["learn"]
-
-
-def _episode(job) -> dict:
-    """One training episode on one robot (runs in a worker process)."""
-    from imitwalk.metrics import walk_metrics
-    from imitwalk.perturb import perturbed
-    from imitwalk.sim import make_plant, run
-
-    robot, gait, scale, cfg, models, seed, explore, rng_seed, seconds = job
-    policy = build_policy(gait, scale, cfg, models, explore=explore, rng_seed=rng_seed, robot=robot)
-    ref = gait.ref
-    steps = round(seconds / ref.dt)
-    opts = perturbed(
-        seed, ref.sim_options(), disturbance=seed != 0, friction_range=tuple(cfg.train_friction)
-    )
-    ro = run(make_plant(robot, opts, cfg.engine), policy, steps)
-    m = walk_metrics(
-        ro,
-        ref.expected_distance(scale, ro.seconds),
-        ref.trajectory(scale, ro.seconds),
-        ref.track(scale, ro.seconds),
-    )
-    out = {"seed": seed, "metrics": m.to_dict(), "ticks": len(ro.t)}
-    if policy.tick_states:
-        out["tick"] = (np.asarray(policy.tick_states), np.asarray(policy.tick_actions))
-        out["tick_pred"] = float(np.mean(policy.tick_predicted)) if policy.tick_predicted else None
-    if policy.steps is not None:
-        out["step"] = policy.steps.episode()
-        out["step_pred"] = (
-            float(np.mean(policy.steps.predicted)) if policy.steps.predicted else None
-        )
-    g = ro.gyro[len(policy.start) - gait.n_ticks :]
-    out["gyro_cost"] = float(stability_cost(g, np.ones(3)).mean()) if len(g) else None
-    return out
 
 
 def _iteration_log(scale, it, results, reports, t0) -> dict:
@@ -151,6 +121,7 @@ def learn(
         polishing = state.get("consolidate_left") is not None
         draw = state["total_iterations"] if config.fresh_robots else 0
         seeds = train_seeds(config.train_models, draw)
+        run_cfg = config.with_offset(state.get("offset"))  # the offset kept so far
         explore = 0.0
         if sch.iterations > 1 and not polishing:
             explore = max(0.0, 1.0 - it / (sch.iterations - 1))
@@ -159,7 +130,7 @@ def learn(
                 robot,
                 gait,
                 scale,
-                config,
+                run_cfg,
                 models,
                 s,
                 explore,
@@ -168,7 +139,7 @@ def learn(
             )
             for j, s in enumerate(seeds)
         ]
-        results = run_parallel(_episode, jobs, config.workers)
+        results = run_parallel(run_episode, jobs, config.workers)
         reports = models.held_out(results)
         for r in results:
             for kind in ("tick", "step"):
@@ -186,7 +157,9 @@ def learn(
             state["failures"] += 1
             state["clean"] = 0
             if state["failures"] > sch.retries:
-                state["done"] = True
+                state["done"] = not _retry_with_offset(
+                    gait, robot, config, data, scale, state, progress
+                )
         elif last:
             state["clean"] = state.get("clean", 0) + 1
         passed = not polishing and last and not fell and state.get("clean", 0) >= sch.confirm
@@ -212,10 +185,15 @@ def learn(
         rd.write_json("checkpoint.json", state)
         if progress:
             progress(_progress_line(entry))
+    if config.offsets and state["passed"]:  # and at the scale reached (once per scale)
+        _retry_with_offset(gait, robot, config, data, max(state["passed"]), state, progress)
+        rd.write_json("checkpoint.json", state)
+    run_cfg = config.with_offset(state.get("offset"))
     for key, values in (("gain", config.gains), ("cadence", config.cadences)):
         if values and config.steps and state["passed"] and key not in state:
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain
-            choice = _tune(gait, robot, config, data, max(state["passed"]), key, gain, progress)
+            top = max(state["passed"])
+            choice = _tune(gait, robot, run_cfg, data, top, key, values, gain, progress)
             state[key] = choice.to_dict()
             state["sim_seconds"] += choice.sim_seconds
             state["wall_seconds"] += choice.wall_seconds
@@ -231,6 +209,10 @@ def learn(
         "gain_trials": state.get("gain"),
         "cadence": state["cadence"]["cadence"] if "cadence" in state else 1.0,
         "cadence_trials": state.get("cadence"),
+        "channel_offset": (
+            {config.offset_channel: state["offset"]} if state.get("offset") is not None else None
+        ),
+        "offset_trials": state.get("offset_trials", []),
         "gait": gait.report(),
         "config": asdict(config),
     }
@@ -238,17 +220,38 @@ def learn(
     return summary
 
 
-def _tune(gait, robot, config: LearnConfig, data, scale, key, gain, progress):
-    """Trials at the scale reached (:func:`imitwalk.trust.tune_gain`) of the channel gain
-    (``key="gain"``), or of the cadence with the channel gain ``gain`` (``"cadence"``)."""
+def _retry_with_offset(gait, robot, config: LearnConfig, data, scale, state, progress) -> bool:
+    """The schedule would stop at ``scale``: try ``config.offsets`` there (once per scale).
+    True if another offset measured better; it is kept and the schedule goes on."""
+    if not (config.offsets and config.steps) or scale in state.get("offset_tried", []):
+        return False
+    state.setdefault("offset_tried", []).append(scale)
+    run_cfg = config.with_offset(state.get("offset"))
+    now = float(run_cfg.step.offset_vector[STEP_CHANNELS.index(config.offset_channel)])
+    values = sorted(set(config.offsets) | {now}, key=lambda v: (abs(v - now), v))  # ties: now
+    gain = run_cfg.step.gain
+    choice = _tune(gait, robot, run_cfg, data, scale, "offset", values, gain, progress)
+    state.setdefault("offset_trials", []).append({"scale": scale, **choice.to_dict()})
+    state["sim_seconds"] += choice.sim_seconds
+    state["wall_seconds"] += choice.wall_seconds
+    if choice.gain == now:
+        return False
+    state["offset"], state["failures"] = choice.gain, 0
+    return True
+
+
+def _tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progress):
+    """Trials at ``scale`` (:func:`imitwalk.trust.tune_gain`) of ``values`` of the channel
+    gain (``key="gain"``), of the cadence with the channel gain ``gain`` (``"cadence"``),
+    or of the channel offset with that gain (``"offset"``)."""
     t0 = time.perf_counter()
     models = fit_models(data, config)
-    values = config.gains if key == "gain" else config.cadences
 
     def episodes(value: float, seeds) -> list[dict]:
         g = value if key == "gain" else gain
         rate = value if key == "cadence" else 1.0
-        cfg = replace(config, step=replace(config.step, gain=g))
+        cfg = config.with_offset(value) if key == "offset" else config
+        cfg = replace(cfg, step=replace(cfg.step, gain=g))
         walk = gait  # the gait the schedule learned, at the candidate cadence
         if rate != 1.0:
             walk = GaitModel(with_cadence(gait.ref, rate), gait.scales, config.gait)
@@ -256,7 +259,7 @@ def _tune(gait, robot, config: LearnConfig, data, scale, key, gain, progress):
             (robot, walk, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
             for j, s in enumerate(seeds)
         ]
-        return [r["metrics"] for r in run_parallel(_episode, jobs, config.workers)]
+        return [r["metrics"] for r in run_parallel(run_episode, jobs, config.workers)]
 
     choice = tune_gain(episodes, values, trial_seeds(config.gain_robots), progress, key)
     if progress:

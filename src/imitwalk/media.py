@@ -74,6 +74,9 @@ def gain(metrics: dict) -> str:
     ran, in a phrase."""
     parts = []
     for key, label in LABELS.items():
+        if key == "offset":  # tried where the schedule stalled, if at all
+            parts += _offset(metrics, label)
+            continue
         value = metrics.get("channel_gain" if key == "gain" else key, 1.0)
         out, trials = f"{label} {value:g}", metrics.get(f"{key}_trials")
         if trials:
@@ -81,6 +84,18 @@ def gain(metrics: dict) -> str:
             out += f" (trials on {len(trials['seeds'])} robots: {rows})"
         parts.append(out)
     return "; ".join(parts)
+
+
+def _offset(metrics: dict, label: str) -> list[str]:
+    kept = metrics.get("channel_offset") or {}
+    trials = metrics.get("offset_trials") or []
+    if not kept and not trials:
+        return []
+    out = label + " " + (", ".join(f"{c} {v:g}" for c, v in kept.items()) or "none")
+    for t in trials:
+        rows = ", ".join(f"{r['offset']:g}: {r['falls']} fell" for r in t["table"])
+        out += f" (trials at scale {t['scale']:g} on {len(t['seeds'])} robots: {rows})"
+    return [out]
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:

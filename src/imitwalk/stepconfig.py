@@ -67,24 +67,29 @@ class StepConfig:
             apart, and a narrower step lands one foot on the other.
         weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
             on the deviation from the target state (the walk's own mean state, heading 0).
-        effort: weight of Σ (c / c_max)² in the objective.
-        horizon: steps predicted ahead (later steps take the nominal, zero, channels).
-        candidates: random candidates per decision (plus the nominal zero).
+        effort: weight of Σ ((c − offset) / c_max)² in the objective.
+        horizon: steps predicted ahead (later steps take the nominal channels: ``offset``).
+        candidates: random candidates per decision (plus the nominal, ``offset``).
         explore: exploration noise, a fraction of c_max, in the first iteration at a scale.
         n_centers, ridge: of the step model's RBF network (which also has linear terms).
         ensemble: step models fitted to bootstrap resamples of the recorded episodes
             (:class:`~imitwalk.ensemble.ModelEnsemble`); a candidate is scored by its
-            predicted gain over the zero channels in the least favourable one (1: one
+            predicted gain over the nominal channels in the least favourable one (1: one
             model on all the data, scored as it predicts).
-        margin: act only if every member predicts a gain over the zero channels of at
-            least this fraction of the zero channels' own predicted cost (0: any gain).
+        margin: act only if every member predicts a gain over the nominal channels of at
+            least this fraction of the nominal channels' own predicted cost (0: any gain).
             The model is least trustworthy where its predicted gains are small; a
             margin keeps the walk on the reference there.
-        gain: the channel values the search chooses are multiplied by this (a trust
-            factor on the model's corrections: 1 applies them as predicted, 0 turns them
-            off). The learner can pick it from measured trials (``LearnConfig.gains``).
+        gain: the search's correction (its channel values minus ``offset``) is
+            multiplied by this (a trust factor on the model's corrections: 1 applies them
+            as predicted, 0 turns them off). The learner can pick it from measured
+            trials (``LearnConfig.gains``).
         servo_state: add :data:`SERVO_STATE` to the step state (off by default). It is
             not in the objective (weight 0); the step model may use it to predict.
+        offset: a constant value per channel in :data:`STEP_CHANNELS` order (empty: all
+            0) that every step takes before the search's correction: the search's nominal
+            candidate, the centre of its box and of the exploration noise. The learner
+            picks it from measured trials (``LearnConfig.offsets``); units as ``c_max``.
     """
 
     channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
@@ -100,11 +105,17 @@ class StepConfig:
     margin: float = 0.0
     gain: float = 1.0
     servo_state: bool = False
+    offset: tuple[float, ...] = ()
 
     @property
     def state_names(self) -> tuple[str, ...]:
         """The step state's names, in order."""
         return STEP_STATE + (SERVO_STATE if self.servo_state else ())
+
+    @property
+    def offset_vector(self) -> np.ndarray:
+        """``(len(STEP_CHANNELS),)`` the constant channel values (zeros if none) [c_max units]."""
+        return np.zeros(len(STEP_CHANNELS)) if not self.offset else np.asarray(self.offset, float)
 
     @property
     def state_weights(self) -> np.ndarray:
@@ -135,5 +146,17 @@ class StepConfig:
                 f"step.weights has {len(self.weights)} values: expected one per state entry of "
                 f"{', '.join(STEP_STATE)}"
             )
+        if self.offset:
+            if len(self.offset) != len(STEP_CHANNELS):
+                raise ConfigError(
+                    f"step.offset has {len(self.offset)} values: expected one per channel of "
+                    f"{', '.join(STEP_CHANNELS)}"
+                )
+            for name, v, hi in zip(STEP_CHANNELS, self.offset, self.c_max, strict=True):
+                on = name in self.channels
+                lo = 0.0 if name == "dy" else -hi
+                if v != 0.0 and not (on and lo <= v <= hi):
+                    why = f"outside {lo:g}..{hi:g} (step.c_max)" if on else "not in step.channels"
+                    raise ConfigError(f"step.offset for {name}={v:g}: {why}")
         if not 0.0 <= self.gain <= 2.0:
             raise ConfigError(f"step.gain={self.gain}: expected 0 <= gain <= 2")

@@ -23,7 +23,7 @@ import numpy as np
 __all__ = ["LABELS", "GainChoice", "select_gain", "tune_gain"]
 
 #: What the trials tune, by ``key``, in words (progress lines, the report).
-LABELS = {"gain": "channel gain", "cadence": "cadence"}
+LABELS = {"gain": "channel gain", "cadence": "cadence", "offset": "channel offset"}
 
 
 @dataclass(frozen=True)
