@@ -10,7 +10,9 @@ that measures best: fewest falls, then the longest time up, then the least headi
 drift. This is the paper's execute-and-measure loop applied to one policy parameter;
 nothing here predicts, it only counts (pure NumPy). The same trials then pick the
 cadence (:func:`imitwalk.retarget.cadence.with_cadence`; ``key="cadence"``): how fast
-the loop is played, the step-timing handle of eq. (9), with the gain kept.
+the loop is played, the step-timing handle of eq. (9), with the gain kept. With
+``LearnConfig.offsets`` they also pick a constant channel offset (``key="offset"``,
+``StepConfig.offset``), where the scale schedule stalls and at the scale reached.
 """
 
 from __future__ import annotations
@@ -36,7 +38,8 @@ class GainChoice:
         table: one row per candidate: ``key``, ``falls``, ``mean_time_up_s`` (a fall
             counts its fall time), ``mean_abs_yaw_deg``.
         sim_seconds: simulated time the trials used [s]; wall_seconds: their wall time.
-        key: the parameter tried: ``"gain"`` (the channel gain) or ``"cadence"``.
+        key: the parameter tried: ``"gain"`` (the channel gain), ``"cadence"`` or
+            ``"offset"`` (the channel offset).
     """
 
     gain: float
