@@ -70,32 +70,28 @@ def outcome(ro: Rollout) -> str:
 
 
 def gain(metrics: dict) -> str:
-    """The channel gain and cadence of a run's ``metrics.json``, and their trials if any
-    ran, in a phrase."""
+    """The channel gain, cadence and channel offset of a run's ``metrics.json``, and their
+    trials if any ran, in a phrase (the offset only if it was tried)."""
     parts = []
     for key, label in LABELS.items():
-        if key == "offset":  # tried where the schedule stalled, if at all
-            parts += _offset(metrics, label)
+        if key == "offset":  # one round of trials per scale where they ran, if any
+            kept = metrics.get("channel_offset") or {}
+            rounds = metrics.get("offset_trials") or []
+            if kept or rounds:
+                value = ", ".join(f"{c} {v:g}" for c, v in kept.items()) or "none"
+                parts.append(f"{label} {value}" + "".join(_trials(t, key) for t in rounds))
             continue
         value = metrics.get("channel_gain" if key == "gain" else key, 1.0)
-        out, trials = f"{label} {value:g}", metrics.get(f"{key}_trials")
-        if trials:
-            rows = ", ".join(f"{r[key]:g}: {r['falls']} fell" for r in trials["table"])
-            out += f" (trials on {len(trials['seeds'])} robots: {rows})"
-        parts.append(out)
+        trials = metrics.get(f"{key}_trials")
+        parts.append(f"{label} {value:g}" + (_trials(trials, key) if trials else ""))
     return "; ".join(parts)
 
 
-def _offset(metrics: dict, label: str) -> list[str]:
-    kept = metrics.get("channel_offset") or {}
-    trials = metrics.get("offset_trials") or []
-    if not kept and not trials:
-        return []
-    out = label + " " + (", ".join(f"{c} {v:g}" for c, v in kept.items()) or "none")
-    for t in trials:
-        rows = ", ".join(f"{r['offset']:g}: {r['falls']} fell" for r in t["table"])
-        out += f" (trials at scale {t['scale']:g} on {len(t['seeds'])} robots: {rows})"
-    return [out]
+def _trials(trials: dict, key: str) -> str:
+    """One round of trials (a :class:`imitwalk.trust.GainChoice` as a dict) in words."""
+    rows = ", ".join(f"{r[key]:g}: {r['falls']} fell" for r in trials["table"])
+    where = f"at scale {trials['scale']:g} " if "scale" in trials else ""
+    return f" (trials {where}on {len(trials['seeds'])} robots: {rows})"
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
