@@ -12,7 +12,8 @@ evaluation robot; 30 s, with the initial disturbance, at the run's scale):
   :data:`imitwalk.balance.STEP_CHANNELS` and :data:`imitwalk.balance.STEP_STATE`);
 * a constant offset on the channels and nothing else, e.g. ``dx=-0.005;lean=0.003``
   [m] (``step.offset`` with no step model: the reference with every swing foot landing
-  5 mm short and the centre of mass 3 mm further forward).
+  5 mm short and the centre of mass 3 mm further forward); ``dx=-0.005@R``: the same
+  at cadence R.
 
 The rules are a diagnostic, not a controller the product uses. Prints JSON, one row per
 entry: falls, the robots that fell, mean |yaw|.
@@ -80,13 +81,15 @@ def _one(job) -> dict:
     plant = MujocoPlant(robot, perturbed(seed, disturbance=True))
     scale = lg.scale if scale is None else scale
     q = ref.trajectory(scale, SECONDS)
+    gait = lg.gait
+    if rate and name != "open":
+        gait = GaitModel(ref, lg.gait.scales, lg.config.gait)
     if name == "open":
         ro = playback(plant, q, q0=q[0])
     elif "=" in name:  # a constant offset, no model
-        policy = build_policy(lg.gait, scale, _offset(name, lg.config), Models(), robot=robot)
+        policy = build_policy(gait, scale, _offset(name, lg.config), Models(), robot=robot)
         ro = run(plant, policy, len(q))
     else:
-        gait = GaitModel(ref, lg.gait.scales, lg.config.gait) if rate else lg.gait
         policy = build_policy(gait, scale, lg.config, lg.models, robot=robot)
         if name != "model":
             terms = [(c, s, float(k)) for c, s, k in (t.split(":") for t in name.split(";"))]

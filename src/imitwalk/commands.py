@@ -119,7 +119,13 @@ def retarget(args: argparse.Namespace) -> int:
         rates = ", ".join(f"{r:g}" for r in sc.cadences)
         n, secs = sc.cadence_models, sc.cadence_seconds
         progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
-    res = run(motion, robot, cfg, progress=report)
+    if cfg.search and sc.refine_rounds:
+        at = ", ".join(f"{x:g}" for x in sc.refine_scales)
+        n, secs = sc.refine_models, sc.refine_seconds
+        progress(
+            f"  then up to {sc.refine_rounds} refinement rounds: {n} robots x {secs:g} s at {at}"
+        )
+    res = run(motion, robot, cfg, progress=report, refine_progress=refine_report)
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = args.robot
@@ -129,6 +135,13 @@ def retarget(args: argparse.Namespace) -> int:
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
+
+
+def refine_report(done: int, total: int, trial) -> None:
+    """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
+    what = trial.changed or "searched"
+    mark = " (kept)" if trial.changed and trial.kept else ""
+    progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
 
 
 def playback(args: argparse.Namespace) -> int:
@@ -199,7 +212,9 @@ def learn(args: argparse.Namespace) -> int:
         def report(gen, total, score, params):
             progress(f"  reference search {gen}/{total}: best score {score:.3f}")
 
-        ref = do_retarget(motion, robot, rcfg, progress=report).reference
+        ref = do_retarget(
+            motion, robot, rcfg, progress=report, refine_progress=refine_report
+        ).reference
         ref.settings["robot"] = args.robot
         ref.settings["joint_map"] = args.joint_map
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")

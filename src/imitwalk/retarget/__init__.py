@@ -20,6 +20,7 @@ from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
+from imitwalk.retarget.refine import refine_params
 from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
 from imitwalk.retarget.walkable import build_walkable
@@ -110,13 +111,23 @@ class RetargetResult:
             s = ref.search
             out["search"] = {k: s[k] for k in ("evaluations", "sim_seconds", "wall_seconds")}
             out["search"]["best_score"] = s["best"]["score"]
+        if "refine" in ref.search:
+            r = ref.search["refine"]
+            keys = ("scales", "start_falls", "falls", "sim_seconds", "wall_seconds")
+            out["refine"] = {k: r[k] for k in keys}
+            out["refine"]["runs_per_trial"] = r["trials"][0]["robots"]
+            out["refine"]["trials"] = len(r["trials"])
         if "cadence" in ref.search:
             out["cadence_search"] = ref.search["cadence"]
         return out
 
 
 def retarget(
-    motion: Motion, robot: Robot, config: RetargetConfig | None = None, progress=None
+    motion: Motion,
+    robot: Robot,
+    config: RetargetConfig | None = None,
+    progress=None,
+    refine_progress=None,
 ) -> RetargetResult:
     """Retarget ``motion`` to ``robot``.
 
@@ -124,7 +135,8 @@ def retarget(
         motion: a loaded clip (see :func:`imitwalk.mocap.load_motion`).
         robot: the robot.
         config: settings; progress: optional ``callback(generation, total, score, params)``
-            for the parameter search.
+            for the parameter search; refine_progress: optional ``callback(done, total,
+            trial)`` for its refinement (``search_config.refine_rounds``).
 
     Raises:
         MocapError: the clip has no walking cycle. ConfigError: bad settings.
@@ -156,6 +168,16 @@ def retarget(
                 progress=progress,
                 command=cfg.command,
             )
+            if cfg.search_config.refine_rounds:
+                params, report["refine"] = refine_params(
+                    template,
+                    robot,
+                    params,
+                    cfg.search_config,
+                    dt,
+                    command=cfg.command,
+                    progress=refine_progress,
+                )
         build = build_walkable(template, robot, params, cfg.scales, dt, command=cfg.command)
         ref, frames, seconds = build.reference, build.frames, build.seconds
     ref.search = report

@@ -66,6 +66,10 @@ class SearchConfig:
         cadence_models, cadence_seconds: robots (the nominal one + training
             perturbations, with the evaluation's initial push) and simulated time [s] per
             cadence trial, at the largest of ``scales``.
+        refine_rounds: rounds of :func:`~imitwalk.retarget.refine.refine_params` after
+            the search (0: off); refine_scales: the stride scales it counts falls at;
+            refine_models, refine_seconds: its robots (as for the cadence) and simulated
+            time per robot [s], at each of ``refine_scales``.
     """
 
     generations: int = 5
@@ -80,6 +84,10 @@ class SearchConfig:
     cadences: tuple[float, ...] = ()
     cadence_models: int = 24
     cadence_seconds: float = 20.0
+    refine_rounds: int = 0
+    refine_scales: tuple[float, ...] = (0.8, 0.9, 1.0)
+    refine_models: int = 24
+    refine_seconds: float = 30.0
 
     def __post_init__(self):
         if self.engine not in ENGINES:
@@ -89,6 +97,14 @@ class SearchConfig:
                 raise ConfigError(f"search_config.cadences: {r} is not a rate in 0.5..2")
         if self.cadences and (self.cadence_models < 1 or self.cadence_seconds <= 0):
             raise ConfigError("search_config.cadence_models must be >= 1 and cadence_seconds > 0")
+        if self.refine_rounds < 0:
+            raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
+        if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
+            raise ConfigError("search_config.refine_models must be >= 1 and refine_seconds > 0")
+        if self.refine_rounds and not all(0.0 < x <= 1.0 for x in self.refine_scales or [0]):
+            raise ConfigError(
+                f"search_config.refine_scales: {self.refine_scales} must be scales in (0, 1]"
+            )
 
 
 _IK: dict = {}

@@ -1,0 +1,140 @@
+"""The reference refinement at full stride (``search_config.refine_rounds``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
+
+import pytest
+
+from imitwalk.errors import ConfigError
+from imitwalk.perturb import TRAIN_SEED_BASE
+from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.retarget import refine as refine_mod
+from imitwalk.retarget.refine import STEPS, refine_params
+from imitwalk.retarget.search import BOUNDS, SearchConfig
+
+
+@dataclass
+class _Metrics:
+    fell: bool
+    seconds: float
+    progress_ratio: float
+    yaw_drift_deg: float
+
+
+def _falls(p: dict) -> int:
+    """A made-up landscape: fewest falls at lean 3 mm and ds 0.14."""
+    return round(abs(p["lean"] - 0.003) / 0.0015) + round(abs(p["ds"] - 0.14) / 0.02)
+
+
+@pytest.fixture
+def stubbed(monkeypatch):
+    """No IK, no physics: a 'reference' is its parameters, and its falls are _falls."""
+    played = []
+
+    def build(template, robot, params, scales, dt, ik=None, command=None):
+        return SimpleNamespace(reference=params.to_dict())
+
+    def play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
+        played.append((scale, seconds, tuple(seeds), disturbance))
+        n = _falls(ref)
+        return [
+            SimpleNamespace(metrics=_Metrics(i < n, seconds / 2 if i < n else seconds, 1.0, 0.0))
+            for i in range(len(seeds))
+        ]
+
+    monkeypatch.setattr(refine_mod, "WalkIK", lambda robot: None)
+    monkeypatch.setattr(refine_mod, "build_walkable", build)
+    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    return played
+
+
+def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_when_nothing_helps(stubbed):
+    cfg = SearchConfig(scales=(0.5, 1.0), refine_rounds=5, refine_models=10, refine_seconds=4.0)
+    start = GaitParams(lean=0.0, ds=0.1, lift=BOUNDS["lift"][0])
+    seen = []
+    params, rep = refine_params(None, None, start, cfg, progress=lambda *a: seen.append(a))
+    assert params.lean == pytest.approx(0.003) and params.ds == pytest.approx(0.14)
+    # falls are counted at each refinement scale, on the same training robots, with the push
+    assert rep["start_falls"] == 3 * _falls(start.to_dict()) == 12 and rep["falls"] == 0
+    assert rep["scales"] == [0.8, 0.9, 1.0] == sorted({s for s, *_ in stubbed})
+    assert len({x[2] for x in stubbed}) == 1 and rep["trials"][0]["robots"] == 30
+    seeds = rep["seeds"]
+    assert len(seeds) == 10 and seeds[0] == 0 and min(seeds[1:]) > TRAIN_SEED_BASE
+    assert all(d for *_, d in stubbed)
+    changed = [t["changed"] for t in rep["trials"]]
+    assert changed[0] == "" and "lift-" not in changed  # lift starts at its lower bound
+    kept = [t["changed"] for t in rep["trials"] if t["kept"]]
+    assert kept == ["", "ds+", "lean+", "ds+", "lean+"]
+    # once nothing falls, nothing can beat it: the search ends before its five rounds
+    assert rep["trials"][-1]["changed"] == "lean+" and rep["trials"][-1]["kept"]
+    assert [a[0] for a in seen] == list(range(1, len(rep["trials"]) + 1))
+    assert [a[2].kept for a in seen] == [t["kept"] for t in rep["trials"]]
+
+
+def test_a_nudge_that_costs_progress_is_not_kept(stubbed, monkeypatch):
+    def play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
+        prog = 0.5 if ref["lean"] > 0.001 else 1.0  # more lean: fewer falls, but shuffles
+        n = _falls(ref)
+        return [
+            SimpleNamespace(metrics=_Metrics(i < n, seconds, prog, 0.0)) for i in range(len(seeds))
+        ]
+
+    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    cfg = SearchConfig(refine_rounds=2, refine_models=6, refine_seconds=4.0)
+    params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
+    assert params.lean == 0.0 and rep["falls"] == rep["start_falls"] == 2 * 3
+    # a round that keeps nothing ends it (width 0 is its lower bound: no "width-")
+    assert len(rep["trials"]) == 2 * len(STEPS)
+
+
+def test_refinement_settings_are_checked():
+    with pytest.raises(ConfigError, match="refine_rounds"):
+        SearchConfig(refine_rounds=-1)
+    with pytest.raises(ConfigError, match="refine_models"):
+        SearchConfig(refine_rounds=1, refine_models=0)
+    with pytest.raises(ConfigError, match="refine_scales"):
+        SearchConfig(refine_rounds=1, refine_scales=(0.9, 1.2))
+    assert SearchConfig().refine_rounds == 0  # off by default
+
+
+def test_retarget_refines_the_searched_parameters_and_records_it(robot):
+    from imitwalk.mocap import default_clip, load_motion
+
+    sc = SearchConfig(
+        generations=1,
+        population=2,
+        elites=1,
+        scales=(0.3, 0.4),
+        models=1,
+        seconds=1.0,
+        workers=1,
+        refine_rounds=1,
+        refine_scales=(0.4,),
+        refine_models=2,
+        refine_seconds=1.0,
+    )
+    cfg = RetargetConfig(scales=(0.3, 0.4), search_config=sc)
+    res = retarget(load_motion(default_clip()), robot, cfg)
+    ref, rep = res.reference, res.reference.search["refine"]
+    stats = res.stats()["refine"]
+    assert stats["runs_per_trial"] == 2 and stats["trials"] == len(rep["trials"])
+    assert stats["falls"] == rep["falls"] and stats["scales"] == [0.4]
+    assert rep["scales"] == [0.4] and rep["trials"][0]["params"] == ref.search["best"]["params"]
+    assert ref.params == rep["params"]
+    # one second on two robots: nothing falls, so nothing can beat the searched parameters
+    assert rep["falls"] == 0 and len(rep["trials"]) == 1 and rep["trials"][0]["kept"]
+    again = retarget(load_motion(default_clip()), robot, replace(cfg, search=False))
+    assert "refine" not in again.reference.search
+
+
+def test_the_command_line_shows_each_refinement_trial(capsys):
+    from imitwalk.commands import refine_report
+    from imitwalk.retarget.refine import RefineTrial
+
+    trial = RefineTrial({}, "lean+", 3, 72, 29.0, 0.9, 4.0, kept=True)
+    refine_report(2, 25, trial)
+    refine_report(1, 25, RefineTrial({}, "", 9, 72, 28.0, 0.9, 4.0, kept=True))
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["  refine 2/25: lean+: 3/72 fell (kept)", "  refine 1/25: searched: 9/72 fell"]
