@@ -69,7 +69,9 @@ class SearchConfig:
         refine_rounds: rounds of :func:`~imitwalk.retarget.refine.refine_params` after
             the search (0: off); refine_scales: the stride scales it counts falls at;
             refine_models, refine_seconds: its robots (as for the cadence) and simulated
-            time per robot [s], at each of ``refine_scales``.
+            time per robot [s], at each of ``refine_scales``; refine_yaw_slack: if set, a
+            nudge is kept only if its mean |heading drift| is at most this much [deg] above
+            the searched reference's (``None``: heading not guarded).
     """
 
     generations: int = 5
@@ -88,6 +90,7 @@ class SearchConfig:
     refine_scales: tuple[float, ...] = (0.8, 0.9, 1.0)
     refine_models: int = 24
     refine_seconds: float = 30.0
+    refine_yaw_slack: float | None = None
 
     def __post_init__(self):
         if self.engine not in ENGINES:
@@ -101,6 +104,10 @@ class SearchConfig:
             raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
         if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
             raise ConfigError("search_config.refine_models must be >= 1 and refine_seconds > 0")
+        if self.refine_yaw_slack is not None and not self.refine_yaw_slack >= 0:
+            raise ConfigError(
+                f"search_config.refine_yaw_slack: {self.refine_yaw_slack} is not >= 0 degrees"
+            )
         if self.refine_rounds and not all(0.0 < x <= 1.0 for x in self.refine_scales or [0]):
             raise ConfigError(
                 f"search_config.refine_scales: {self.refine_scales} must be scales in (0, 1]"
