@@ -50,7 +50,7 @@ def stubbed(monkeypatch):
     return played
 
 
-def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_when_nothing_helps(stubbed):
+def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_once_nothing_falls(stubbed):
     cfg = SearchConfig(scales=(0.5, 1.0), refine_rounds=5, refine_models=10, refine_seconds=4.0)
     start = GaitParams(lean=0.0, ds=0.1, lift=BOUNDS["lift"][0])
     seen = []
@@ -122,6 +122,13 @@ def test_refinement_settings_are_checked():
     with pytest.raises(ConfigError, match="refine_scales"):
         SearchConfig(refine_rounds=1, refine_scales=(0.9, 1.2))
     assert SearchConfig().refine_rounds == 0  # off by default
+    from imitwalk.config import apply_overrides
+
+    cfg = apply_overrides(
+        RetargetConfig(),
+        ["search_config.refine_rounds=2", "search_config.refine_yaw_slack=3"],
+    )
+    assert cfg.search_config.refine_rounds == 2 and cfg.search_config.refine_yaw_slack == 3
 
 
 def test_retarget_refines_the_searched_parameters_and_records_it(robot):
