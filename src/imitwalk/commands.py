@@ -110,22 +110,16 @@ def retarget(args: argparse.Namespace) -> int:
     motion = _motion(args)
     progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
 
-    def report(gen, total, score, params):
-        shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
-        progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
-
     sc = cfg.search_config
     if cfg.search and sc.cadences:
         rates = ", ".join(f"{r:g}" for r in sc.cadences)
         n, secs = sc.cadence_models, sc.cadence_seconds
         progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
     if cfg.search and sc.refine_rounds:
-        at = ", ".join(f"{x:g}" for x in sc.refine_scales)
-        n, secs = sc.refine_models, sc.refine_seconds
-        progress(
-            f"  then up to {sc.refine_rounds} refinement rounds: {n} robots x {secs:g} s at {at}"
-        )
-    res = run(motion, robot, cfg, progress=report, refine_progress=refine_report)
+        at = "/".join(f"{x:g}" for x in sc.refine_scales)
+        r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
+        progress(f"  then up to {r} refinement rounds: {n} robots x {secs:g} s at {at}")
+    res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = args.robot
@@ -135,6 +129,12 @@ def retarget(args: argparse.Namespace) -> int:
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
+
+
+def search_report(gen: int, total: int, score: float, params: dict) -> None:
+    """Progress of the reference search (:mod:`imitwalk.retarget.search`)."""
+    shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
+    progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
 
 
 def refine_report(done: int, total: int, trial) -> None:
@@ -208,13 +208,7 @@ def learn(args: argparse.Namespace) -> int:
         motion = _motion(args)
         progress(f"learn: retargeting {motion.source}")
         rcfg = _with_command(apply_overrides(RetargetConfig(), rt_set), args)
-
-        def report(gen, total, score, params):
-            progress(f"  reference search {gen}/{total}: best score {score:.3f}")
-
-        ref = do_retarget(
-            motion, robot, rcfg, progress=report, refine_progress=refine_report
-        ).reference
+        ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
         ref.settings["robot"] = args.robot
         ref.settings["joint_map"] = args.joint_map
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
