@@ -70,6 +70,8 @@ def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_once_nothing
     # once nothing falls, nothing can beat it: the search ends before its five rounds
     assert rep["trials"][-1]["changed"] == "lean+" and rep["trials"][-1]["kept"]
     assert [a[0] for a in seen] == list(range(1, len(rep["trials"]) + 1))
+    fresh = sum(not t["repeat"] for t in rep["trials"])
+    assert len(stubbed) == 3 * fresh and rep["sim_seconds"] == fresh * 3 * 10 * 4.0
     assert [a[2].kept for a in seen] == [t["kept"] for t in rep["trials"]]
 
 
@@ -106,6 +108,10 @@ def test_with_a_yaw_slack_a_nudge_that_turns_the_walk_is_not_kept(stubbed, monke
     params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
     # lean 1.5 mm drifts 2.25 deg more than the start (kept); 3 mm 4.5 deg, beyond the slack
     assert params.lean == pytest.approx(0.0015) and rep["falls"] == 3
+    # round 2 comes back to sets round 1 played (lean 0, the widths): measured once, reused
+    again = {t["changed"]: t for t in rep["trials"] if t["repeat"]}
+    assert "lean-" in again and again["lean-"]["params"] == rep["trials"][0]["params"]
+    assert again["lean-"]["falls"] == rep["trials"][0]["falls"]
     # the slack is counted from the searched set, not from the last one kept
     params, rep = refine_params(None, None, GaitParams(lean=-0.0015, ds=0.14), cfg)
     assert params.lean == pytest.approx(0.0015) and rep["falls"] == 3

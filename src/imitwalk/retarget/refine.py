@@ -64,7 +64,9 @@ class RefineTrial:
         params: the reference parameters; changed: ``"name+"``/``"name-"`` (``""``: the
             search's own); falls, robots: how many runs fell, of how many (robots × scales).
         mean_seconds: mean time up [s]; mean_progress: mean progress ratio;
-        mean_abs_yaw_deg: mean |heading drift| [deg]; kept: whether it was kept.
+        mean_abs_yaw_deg: mean |heading drift| [deg]; kept: whether it was kept;
+        repeat: the set was played before (a later round came back to it), and its
+        measurement was reused (the runs are deterministic).
     """
 
     params: dict
@@ -75,6 +77,7 @@ class RefineTrial:
     mean_progress: float
     mean_abs_yaw_deg: float
     kept: bool = False
+    repeat: bool = False
 
     def beats(self, other: RefineTrial, start: RefineTrial, yaw_slack: float | None) -> bool:
         """Fewer falls than ``other`` (or as many, and longer up), at no great cost in
@@ -118,8 +121,14 @@ def refine_params(
     total = 1 + config.refine_rounds * 2 * len(names)
     t0 = time.perf_counter()
     trials: list[RefineTrial] = []
+    played: dict[tuple, RefineTrial] = {}
 
     def trial(p: GaitParams, changed: str) -> RefineTrial:
+        key = tuple(p.to_dict().values())
+        if key in played:
+            out = replace(played[key], changed=changed, repeat=True)
+            trials.append(out)
+            return out
         ref = build_walkable(template, robot, p, scales, dt, ik=ik, command=command).reference
         ms = [
             r.metrics
@@ -146,6 +155,7 @@ def refine_params(
             mean_abs_yaw_deg=float(np.mean([abs(m.yaw_drift_deg) for m in ms])),
         )
         trials.append(out)
+        played[key] = out
         return out
 
     def report(t: RefineTrial, keep: bool) -> None:
@@ -189,7 +199,10 @@ def refine_params(
         "start_falls": rows[0].falls,
         "falls": best.falls,
         "params": current.to_dict(),
-        "sim_seconds": len(rows) * len(scales) * len(seeds) * config.refine_seconds,
+        "sim_seconds": sum(not r.repeat for r in rows)
+        * len(scales)
+        * len(seeds)
+        * config.refine_seconds,
         "wall_seconds": time.perf_counter() - t0,
     }
     return current, out
