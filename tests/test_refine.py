@@ -11,7 +11,7 @@ from imitwalk.errors import ConfigError
 from imitwalk.perturb import TRAIN_SEED_BASE
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.retarget import refine as refine_mod
-from imitwalk.retarget.refine import STEPS, refine_params
+from imitwalk.retarget.refine import STEPS, refine_params, refine_per_scale
 from imitwalk.retarget.search import BOUNDS, SearchConfig
 
 
@@ -118,6 +118,38 @@ def test_with_a_yaw_slack_a_nudge_that_turns_the_walk_is_not_kept(stubbed, monke
     assert [t["changed"] for t in rep["trials"] if t["kept"]] == ["", "lean+", "lean+"]
 
 
+def test_per_scale_refinement_finds_each_scale_its_own_set(stubbed, monkeypatch):
+    def play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
+        stubbed.append((scale, seconds, tuple(seeds), disturbance))
+        best_lean = 0.003 if scale > 0.95 else 0.0  # full stride wants lean, 0.8 does not
+        n = round(abs(ref["lean"] - best_lean) / 0.0015) + round(abs(ref["ds"] - 0.14) / 0.02)
+        return [
+            SimpleNamespace(metrics=_Metrics(i < n, seconds, 1.0, 0.0)) for i in range(len(seeds))
+        ]
+
+    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    cfg = SearchConfig(refine_rounds=4, refine_scales=(1.0, 0.8), refine_models=5)
+    start = GaitParams(lean=0.0, ds=0.12)
+    seen = []
+    own, rep = refine_per_scale(None, None, start, cfg, progress=lambda *a: seen.append(a))
+    assert sorted(own) == [0.8, 1.0]
+    assert own[0.8].lean == 0.0 and own[0.8].ds == pytest.approx(0.14)
+    assert own[1.0].lean == pytest.approx(0.003) and own[1.0].ds == pytest.approx(0.14)
+    # each trial is played at its own scale only, and both start from the searched set
+    per = rep["per_scale"]
+    assert set(per) == {"0.8", "1"} and rep["scales"] == [0.8, 1.0]
+    for key, at in (("0.8", 0.8), ("1", 1.0)):
+        assert per[key]["scales"] == [at] and per[key]["trials"][0]["params"] == start.to_dict()
+        assert all(t["at"] == at and t["robots"] == 5 for t in per[key]["trials"])
+    assert rep["start_falls"] == 1 + 3 and rep["falls"] == 0
+    assert rep["trials"] == per["0.8"]["trials"] + per["1"]["trials"]
+    assert rep["sim_seconds"] == per["0.8"]["sim_seconds"] + per["1"]["sim_seconds"]
+    # one progress line per trial, counted over both scales
+    assert [a[0] for a in seen] == list(range(1, len(rep["trials"]) + 1))
+    assert [a[2].at for a in seen] == [t["at"] for t in rep["trials"]]
+    assert len({a[1] for a in seen}) == 1
+
+
 def test_refinement_settings_are_checked():
     with pytest.raises(ConfigError, match="refine_rounds"):
         SearchConfig(refine_rounds=-1)
@@ -165,6 +197,42 @@ def test_retarget_refines_the_searched_parameters_and_records_it(robot):
     assert rep["falls"] == 0 and len(rep["trials"]) == 1 and rep["trials"][0]["kept"]
     again = retarget(load_motion(default_clip()), robot, replace(cfg, search=False))
     assert "refine" not in again.reference.search
+    assert again.reference.scale_params == {}  # one set for every scale
+    # per scale: the 0.4 loop is solved with its own set (here the searched one: nothing
+    # fell), the rest of the grid with the searched set; it survives a save and a load
+    per = replace(cfg, search_config=replace(sc, refine_per_scale=True))
+    res = retarget(load_motion(default_clip()), robot, per)
+    ref, rep = res.reference, res.reference.search["refine"]
+    assert set(rep["per_scale"]) == {"0.4"} and rep["trials"][0]["at"] == 0.4
+    assert ref.scale_params == {"0.4": rep["per_scale"]["0.4"]["params"]}
+    assert res.stats()["scale_params"] == ref.scale_params
+    assert ref.params_at(0.4) == ref.scale_params["0.4"] and ref.params_at(0.3) == ref.params
+    with pytest.raises(ConfigError, match=r"refine_scales \[0.35\]: not grid scales \(0.3, 0.4\)"):
+        retarget(
+            None,
+            robot,
+            replace(cfg, search_config=replace(sc, refine_per_scale=True, refine_scales=(0.35,))),
+        )
+
+
+def test_a_reference_can_be_solved_with_its_own_parameters_at_some_scales(robot, tmp_path):
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.retarget import Reference, extract_template
+    from imitwalk.retarget.walkable import build_walkable
+
+    template = extract_template(load_motion(default_clip()))
+    base, high = GaitParams(), GaitParams(lift=0.03)
+    one = build_walkable(template, robot, base, [0.3, 0.4], 0.01).reference
+    two = build_walkable(template, robot, base, [0.3, 0.4], 0.01, scale_params={0.4: high})
+    two = Reference.load(two.reference.save(tmp_path / "two.npz"))
+    assert two.scale_params == {"0.4": high.to_dict()} and two.params == base.to_dict()
+    assert two.params_at(0.4)["lift"] == 0.03 and two.params_at(0.31) == base.to_dict()
+    # the 0.3 loop is the same; the 0.4 one lifts its swing foot higher
+    assert (two.loops[0] == one.loops[0]).all() and not (two.loops[1] == one.loops[1]).all()
+    lift = lambda r: (r.plan["l_sole"][1][:, 2].max(), r.plan["l_sole"][0][:, 2].max())  # noqa: E731
+    assert lift(two)[0] > lift(one)[0] + 0.005 and lift(two)[1] == lift(one)[1]
+    with pytest.raises(ConfigError, match="not a grid scale"):
+        build_walkable(template, robot, base, [0.3, 0.4], 0.01, scale_params={0.5: high})
 
 
 def test_the_command_line_shows_each_refinement_trial(capsys):
@@ -174,5 +242,10 @@ def test_the_command_line_shows_each_refinement_trial(capsys):
     trial = RefineTrial({}, "lean+", 3, 72, 29.0, 0.9, 4.0, kept=True)
     refine_report(2, 25, trial)
     refine_report(1, 25, RefineTrial({}, "", 9, 72, 28.0, 0.9, 4.0, kept=True))
+    refine_report(3, 75, RefineTrial({}, "ds-", 2, 24, 29.0, 0.9, 4.0, kept=True, at=1.0))
     err = capsys.readouterr().err.splitlines()
-    assert err == ["  refine 2/25: lean+: 3/72 fell (kept)", "  refine 1/25: searched: 9/72 fell"]
+    assert err == [
+        "  refine 2/25: lean+: 3/72 fell (kept)",
+        "  refine 1/25: searched: 9/72 fell",
+        "  refine 3/75: ds- at 1: 2/24 fell (kept)",
+    ]

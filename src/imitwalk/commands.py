@@ -139,7 +139,7 @@ def search_report(gen: int, total: int, score: float, params: dict) -> None:
 
 def refine_report(done: int, total: int, trial) -> None:
     """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
-    what = trial.changed or "searched"
+    what = (trial.changed or "searched") + ("" if trial.at is None else f" at {trial.at:g}")
     mark = " (kept)" if trial.changed and trial.kept else ""
     progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
 

@@ -150,7 +150,7 @@ def build_policy(
         steps = StepController(
             config.step,
             gait.n_ticks,
-            float(ref.params.get("ds", 0.1)),
+            float(ref.params_at(scale).get("ds", 0.1)),
             model=models.step,
             rng=rng,
             explore=config.step.explore * explore,

@@ -20,7 +20,7 @@ from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
-from imitwalk.retarget.refine import refine_params
+from imitwalk.retarget.refine import refine_params, refine_per_scale
 from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
 from imitwalk.retarget.walkable import build_walkable
@@ -106,6 +106,8 @@ class RetargetResult:
             "frames_per_second_solved": self.frames_solved / max(self.solve_seconds, 1e-9),
             "params": ref.params,
         }
+        if ref.scale_params:
+            out["scale_params"] = ref.scale_params
         out.update({k: v for k, v in ref.checks.items() if k != "scale"})
         if ref.search.get("best"):
             s = ref.search
@@ -144,6 +146,12 @@ def retarget(
     cfg = config or RetargetConfig()
     if cfg.mapping not in MAPPINGS:
         raise unknown_name("mapping", cfg.mapping, MAPPINGS, ConfigError)
+    sc = cfg.search_config
+    if cfg.search and sc.refine_rounds and sc.refine_per_scale:
+        off = [x for x in sc.refine_scales if not np.isclose(cfg.scales, x, atol=1e-9).any()]
+        if off:
+            grid = ", ".join(f"{x:g}" for x in cfg.scales)
+            raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
     template = extract_template(motion)
     dt = 1.0 / cfg.control_hz
     t0 = time.perf_counter()
@@ -157,7 +165,7 @@ def retarget(
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
         report = {}
     else:
-        params, report = cfg.params, {}
+        params, report, own = cfg.params, {}, None
         if cfg.search:
             params, report = search_params(
                 template,
@@ -168,17 +176,18 @@ def retarget(
                 progress=progress,
                 command=cfg.command,
             )
-            if cfg.search_config.refine_rounds:
-                params, report["refine"] = refine_params(
-                    template,
-                    robot,
-                    params,
-                    cfg.search_config,
-                    dt,
-                    command=cfg.command,
-                    progress=refine_progress,
+            if sc.refine_rounds:
+                how = refine_per_scale if sc.refine_per_scale else refine_params
+                out, report["refine"] = how(
+                    template, robot, params, sc, dt, command=cfg.command, progress=refine_progress
                 )
-        build = build_walkable(template, robot, params, cfg.scales, dt, command=cfg.command)
+                if sc.refine_per_scale:
+                    own = out
+                else:
+                    params = out
+        build = build_walkable(
+            template, robot, params, cfg.scales, dt, command=cfg.command, scale_params=own
+        )
         ref, frames, seconds = build.reference, build.frames, build.seconds
     ref.search = report
     ref.source = motion.source

@@ -80,6 +80,8 @@ class Reference:
         clipped: one dict per (scale, joint) that sat on a joint limit.
         checks: kinematic checks of the largest scale (tilt, clearance, closure, skate).
         params: the reference parameters; search: the report of the search for them.
+        scale_params: other parameters at some grid scales (``{"1": {...}}``; empty:
+            ``params`` at every scale); see :meth:`params_at`.
         source: the mocap file; settings: how it was retargeted; cycles: ``(C, 2)``
             source frames of the gait cycles used.
         plan: the task-space plan the walkable IK solved, per scale and tick of the
@@ -114,6 +116,7 @@ class Reference:
     plan: dict = field(default_factory=dict)
     command: dict = field(default_factory=dict)
     motion: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
+    scale_params: dict = field(default_factory=dict)
 
     # -- access ---------------------------------------------------------------
     def _bracket(self, scale: float) -> tuple[int, int, float]:
@@ -134,6 +137,11 @@ class Reference:
         i, j, w = self._bracket(scale)
         mix = lambda a: (1.0 - w) * a[i] + w * a[j]  # noqa: E731
         return mix(self.starts), mix(self.loops), float(mix(self.strides))
+
+    def params_at(self, scale: float) -> dict:
+        """The reference parameters the nearest grid scale to ``scale`` was solved with."""
+        near = self.scales[int(np.argmin(np.abs(self.scales - scale)))]
+        return self.scale_params.get(f"{near:g}", self.params)
 
     def plan_at(self, scale: float) -> dict[str, np.ndarray]:
         """The task-space plan ``(M + N, ...)`` arrays at ``scale`` (blended between grid
@@ -282,6 +290,7 @@ class Reference:
             "scales": self.scales.tolist(),
             "strides_m": self.strides.tolist(),
             "params": self.params,
+            **({"scale_params": self.scale_params} if self.scale_params else {}),
             "checks": self.checks,
             "command": self.gait_command().to_dict(),
             "source": self.source,

@@ -21,6 +21,12 @@ the walk drifts at most that many degrees more than the searched reference. It s
 after ``refine_rounds`` rounds, earlier when a whole round keeps nothing or when nothing
 falls. Like the search it uses training robots only (:func:`imitwalk.perturb.train_seeds`),
 never an evaluation robot, and no dynamics model: it measures.
+
+:func:`refine_per_scale` (``refine_per_scale``) runs the same search once per scale of
+``refine_scales``, each judged at its own scale only and starting from the searched
+set, so that the reference can be solved with each scale's own set there
+(:func:`~imitwalk.retarget.walkable.build_walkable`'s ``scale_params``) instead of one
+compromise for every stride.
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["PROGRESS_SLACK", "STEPS", "RefineTrial", "refine_params"]
+__all__ = ["PROGRESS_SLACK", "STEPS", "RefineTrial", "refine_params", "refine_per_scale"]
 
 #: How far one nudge moves each parameter (its units: see :class:`GaitParams`).
 STEPS: dict[str, float] = {
@@ -66,7 +72,8 @@ class RefineTrial:
         mean_seconds: mean time up [s]; mean_progress: mean progress ratio;
         mean_abs_yaw_deg: mean |heading drift| [deg]; kept: whether it was kept;
         repeat: the set was played before (a later round came back to it), and its
-        measurement was reused (the runs are deterministic).
+        measurement was reused (the runs are deterministic); at: the one scale it was
+        judged at (per-scale refinement; ``None``: every one of ``refine_scales``).
     """
 
     params: dict
@@ -78,6 +85,7 @@ class RefineTrial:
     mean_abs_yaw_deg: float
     kept: bool = False
     repeat: bool = False
+    at: float | None = None
 
     def beats(self, other: RefineTrial, start: RefineTrial, yaw_slack: float | None) -> bool:
         """Fewer falls than ``other`` (or as many, and longer up), at no great cost in
@@ -97,6 +105,7 @@ def refine_params(
     base: SimOptions | None = None,
     command: GaitCommand | None = None,
     progress=None,
+    at: float | None = None,
 ) -> tuple[GaitParams, dict]:
     """Nudge ``params`` (the search's best) while the reference falls on fewer robots.
 
@@ -108,13 +117,14 @@ def refine_params(
         dt: control period [s]; base: simulation options every run starts from;
         command: the commanded gait; progress: optional ``callback(done, total, trial)``
             after each trial (``trial.kept``: whether it was kept).
+        at: judge at this one scale instead of every one of ``refine_scales``.
 
     Returns:
         the kept parameters and a JSON-able report of every trial.
     """
     from imitwalk.playback import play_reference  # it imports this package
 
-    scales = sorted(config.refine_scales)
+    scales = [at] if at is not None else sorted(config.refine_scales)
     seeds = train_seeds(config.refine_models)
     ik = WalkIK(robot)
     names = [f.name for f in fields(GaitParams)]
@@ -153,6 +163,7 @@ def refine_params(
             mean_seconds=float(np.mean([m.seconds for m in ms])),
             mean_progress=float(np.mean([m.progress_ratio for m in ms])),
             mean_abs_yaw_deg=float(np.mean([abs(m.yaw_drift_deg) for m in ms])),
+            at=at,
         )
         trials.append(out)
         played[key] = out
@@ -188,7 +199,9 @@ def refine_params(
             break
     rows = [replace(t, kept=i in kept) for i, t in enumerate(trials)]
     out = {
-        "method": "coordinate search on open-loop falls, summed over scales",
+        "method": "coordinate search on open-loop falls, summed over scales"
+        if at is None
+        else "coordinate search on open-loop falls at one scale",
         "scales": scales,
         "seconds": config.refine_seconds,
         "seeds": list(seeds),
@@ -206,3 +219,47 @@ def refine_params(
         "wall_seconds": time.perf_counter() - t0,
     }
     return current, out
+
+
+def refine_per_scale(
+    template: GaitTemplate,
+    robot: Robot,
+    params: GaitParams,
+    config,
+    dt: float = 0.01,
+    base: SimOptions | None = None,
+    command: GaitCommand | None = None,
+    progress=None,
+) -> tuple[dict[float, GaitParams], dict]:
+    """:func:`refine_params` once per scale of ``config.refine_scales``, each judged at
+    that scale alone and starting from ``params``.
+
+    Returns:
+        ``{scale: kept parameters}`` and a JSON-able report: the summed falls, cost and
+        trials (each with its scale ``at``), and each scale's own report in ``per_scale``.
+    """
+    scales = sorted(config.refine_scales)
+    kept, reports, done = {}, [], [0]
+    total = len(scales) * (1 + config.refine_rounds * 2 * len(fields(GaitParams)))
+
+    def relay(_done: int, _total: int, trial: RefineTrial) -> None:
+        done[0] += 1
+        if progress:
+            progress(done[0], total, trial)
+
+    for s in scales:
+        kept[s], rep = refine_params(
+            template, robot, params, config, dt, base, command, relay, at=s
+        )
+        reports.append(rep)
+    out = {
+        "method": "coordinate search on open-loop falls, one per scale",
+        "scales": scales,
+        "start_falls": sum(r["start_falls"] for r in reports),
+        "falls": sum(r["falls"] for r in reports),
+        "trials": [t for r in reports for t in r["trials"]],
+        "sim_seconds": sum(r["sim_seconds"] for r in reports),
+        "wall_seconds": sum(r["wall_seconds"] for r in reports),
+        "per_scale": {f"{s:g}": r for s, r in zip(scales, reports, strict=True)},
+    }
+    return kept, out

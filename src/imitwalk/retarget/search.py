@@ -71,7 +71,10 @@ class SearchConfig:
             refine_models, refine_seconds: its robots (as for the cadence) and simulated
             time per robot [s], at each of ``refine_scales``; refine_yaw_slack: if set, a
             nudge is kept only if its mean |heading drift| is at most this much [deg] above
-            the searched reference's (``None``: heading not guarded).
+            the searched reference's (``None``: heading not guarded); refine_per_scale:
+            refine each of ``refine_scales`` on its own, judged there alone, and solve
+            the reference with each one's set at that scale
+            (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales).
     """
 
     generations: int = 5
@@ -91,6 +94,7 @@ class SearchConfig:
     refine_models: int = 24
     refine_seconds: float = 30.0
     refine_yaw_slack: float | None = None
+    refine_per_scale: bool = False
 
     def __post_init__(self):
         if self.engine not in ENGINES:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imitwalk.errors import ConfigError
 from imitwalk.retarget.checks import kinematic_checks
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
@@ -41,6 +42,7 @@ def build_walkable(
     ik: WalkIK | None = None,
     check_scale: float = 1.0,
     command: GaitCommand | None = None,
+    scale_params: dict[float, GaitParams] | None = None,
 ) -> WalkableBuild:
     """Solve the walkable reference at every scale.
 
@@ -51,11 +53,19 @@ def build_walkable(
         ik: a solver to reuse (built if ``None``).
         check_scale: the scale whose kinematics are checked (nearest in the grid).
         command: turn, sidestep, stride fraction and slope (default: straight, level).
+        scale_params: other parameters at some of ``scales`` (``{scale: params}``, e.g.
+            from :func:`~imitwalk.retarget.refine.refine_per_scale`); ``params`` elsewhere.
     """
     ik = ik or WalkIK(robot)
     geom = leg_geometry(robot)
     scales = np.asarray(sorted(scales), dtype=float)
     command = command or GaitCommand()
+    own = {}
+    for s, p in (scale_params or {}).items():
+        near = np.flatnonzero(np.isclose(scales, s, rtol=0.0, atol=1e-9))
+        if not len(near):
+            raise ConfigError(f"scale_params at {s:g}: not a grid scale {scales.tolist()}")
+        own[float(scales[near[0]])] = p
     starts, loops, strides, resid, clipped, travel, motion = [], [], [], [], [], [], []
     plans: dict[str, list] = {k: [] for k in PLAN_KEYS}
     t0 = time.perf_counter()
@@ -66,9 +76,8 @@ def build_walkable(
         # two start-up cycles and two steady ones: by the last cycle every foot has
         # landed by the steady rule, so that cycle is the closed loop and the rest,
         # which ends exactly where the loop begins, is the start-up
-        plan = plan_walk(
-            template, geom, params, float(s), dt, cycles=2, start=True, command=command
-        )
+        p = own.get(float(s), params)
+        plan = plan_walk(template, geom, p, float(s), dt, cycles=2, start=True, command=command)
         res = ik.solve(plan)
         frames += len(plan.phase)
         n_loop = round(plan.period / dt)
@@ -116,6 +125,7 @@ def build_walkable(
         clipped=clipped,
         checks=checks,
         params=params.to_dict(),
+        scale_params={f"{s:g}": p.to_dict() for s, p in sorted(own.items())},
         plan={k: np.stack(v) for k, v in plans.items()},
         command=command.to_dict(),
         motion=np.stack(motion),
