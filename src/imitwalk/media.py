@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from imitwalk import curves, plots
-from imitwalk.retarget.reference import atomic_write
+from imitwalk.fileio import atomic_write
 from imitwalk.robots import Robot
 from imitwalk.sim import MujocoPlant, Rollout, SimOptions, make_plant, playback, run
 from imitwalk.trust import LABELS

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from imitwalk import curves, media, plots
 from imitwalk.evaluate import load_gait
-from imitwalk.retarget.reference import atomic_write
+from imitwalk.fileio import atomic_write
 from imitwalk.robots import Robot, load_robot
 from imitwalk.runs import RunDir
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from imitwalk.errors import RunError
-from imitwalk.retarget.reference import atomic_write
+from imitwalk.fileio import atomic_write
 
 __all__ = ["RunDir"]
 

@@ -9,18 +9,17 @@ the reference parameters and the search that found them, and where it came from.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
 from imitwalk.errors import RunError
+from imitwalk.fileio import atomic_write
 from imitwalk.retarget.command import GaitCommand, advance
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["PLAN_KEYS", "Reference", "atomic_write", "plan_arrays"]
+__all__ = ["PLAN_KEYS", "Reference", "plan_arrays"]
 
 #: Arrays of a stored task-space plan (upper-body roles in :data:`UPPER`; ``yaw`` and
 #: ``path`` as in :class:`~imitwalk.retarget.plan.TaskPlan`; references written before
@@ -41,24 +40,6 @@ def plan_arrays(plan) -> dict[str, np.ndarray]:
         "yaw": plan.yaw,
         "path": plan.path,
     }
-
-
-def atomic_write(path: str | Path, write) -> Path:
-    """Write a file atomically: ``write(tmp_path)`` then rename over ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file normal permissions
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
 
 
 @dataclass

@@ -1,0 +1,36 @@
+"""The house boundary: the NumPy stages and the run folder do not pull in MuJoCo."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+#: Modules that must import without MuJoCo (directly or through another module).
+NUMPY_ONLY = (
+    "balance",
+    "controller",
+    "embedding",
+    "ensemble",
+    "estimator",
+    "fileio",
+    "metrics",
+    "perturb",
+    "predictor",
+    "rbf",
+    "runs",
+    "servo",
+    "stepconfig",
+    "subspace",
+    "trust",
+)
+
+
+def test_numpy_stages_and_the_run_folder_import_without_mujoco():
+    code = (
+        "import importlib, sys\n"
+        f"for m in {NUMPY_ONLY!r}:\n"
+        "    importlib.import_module('imitwalk.' + m)\n"
+        "    assert 'mujoco' not in sys.modules, m\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr.strip().splitlines()[-1]
