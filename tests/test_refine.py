@@ -244,6 +244,17 @@ def test_the_command_line_shows_each_refinement_trial(capsys):
     refine_report(1, 25, RefineTrial({}, "", 9, 72, 28.0, 0.9, 4.0, kept=True))
     refine_report(3, 75, RefineTrial({}, "ds-", 2, 24, 29.0, 0.9, 4.0, kept=True, at=1.0))
     err = capsys.readouterr().err.splitlines()
+    # retarget and learn announce the refinement before the search starts
+    from imitwalk.commands import _announce_search
+
+    _announce_search(RetargetConfig(search_config=SearchConfig(refine_rounds=2)))
+    per = SearchConfig(refine_rounds=1, refine_per_scale=True, refine_scales=(0.9, 1.0))
+    _announce_search(RetargetConfig(search_config=per))
+    _announce_search(RetargetConfig(search=False, search_config=per))
+    assert capsys.readouterr().err.splitlines() == [
+        "  then up to 2 refinement rounds: 24 robots x 30 s at 0.8/0.9/1",
+        "  then up to 1 refinement rounds: 24 robots x 30 s at 0.9/1, each scale on its own",
+    ]
     assert err == [
         "  refine 2/25: lean+: 3/72 fell (kept)",
         "  refine 1/25: searched: 9/72 fell",

@@ -110,15 +110,7 @@ def retarget(args: argparse.Namespace) -> int:
     motion = _motion(args)
     progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
 
-    sc = cfg.search_config
-    if cfg.search and sc.cadences:
-        rates = ", ".join(f"{r:g}" for r in sc.cadences)
-        n, secs = sc.cadence_models, sc.cadence_seconds
-        progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
-    if cfg.search and sc.refine_rounds:
-        at = "/".join(f"{x:g}" for x in sc.refine_scales)
-        r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
-        progress(f"  then up to {r} refinement rounds: {n} robots x {secs:g} s at {at}")
+    _announce_search(cfg)
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
@@ -129,6 +121,20 @@ def retarget(args: argparse.Namespace) -> int:
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
+
+
+def _announce_search(cfg) -> None:
+    """What a RetargetConfig's search does after its generations (progress lines)."""
+    sc = cfg.search_config
+    if cfg.search and sc.cadences:
+        rates = ", ".join(f"{r:g}" for r in sc.cadences)
+        n, secs = sc.cadence_models, sc.cadence_seconds
+        progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
+    if cfg.search and sc.refine_rounds:
+        at = "/".join(f"{x:g}" for x in sc.refine_scales)
+        r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
+        each = ", each scale on its own" if sc.refine_per_scale else ""
+        progress(f"  then up to {r} refinement rounds: {n} robots x {secs:g} s at {at}{each}")
 
 
 def search_report(gen: int, total: int, score: float, params: dict) -> None:
@@ -208,6 +214,7 @@ def learn(args: argparse.Namespace) -> int:
         motion = _motion(args)
         progress(f"learn: retargeting {motion.source}")
         rcfg = _with_command(apply_overrides(RetargetConfig(), rt_set), args)
+        _announce_search(rcfg)
         ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
         ref.settings["robot"] = args.robot
         ref.settings["joint_map"] = args.joint_map
@@ -245,33 +252,15 @@ def evaluate(args: argparse.Namespace) -> int:
     learned_on = cfg.get("learn", {}).get("engine", "mujoco")
     args.engine = args.engine or learned_on
     robot = robot_from(args)
+    common = {"workers": args.workers, "scale": args.scale, "engine": args.engine}
     if args.perturb:
         progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
-        out = robustness_grid(
-            rd.path,
-            robot,
-            args.seconds,
-            args.seeds,
-            workers=args.workers,
-            progress=progress,
-            scale=args.scale,
-            engine=args.engine,
-        )
-        name = _result_name("robustness", args, learned_on)
-        rd.write_json(name, out)
+        out = robustness_grid(rd.path, robot, args.seconds, args.seeds, progress=progress, **common)
     else:
         progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
-        out = evaluate_run(
-            rd.path,
-            robot,
-            args.seconds,
-            args.seeds,
-            workers=args.workers,
-            scale=args.scale,
-            engine=args.engine,
-        )
-        name = _result_name("evaluation", args, learned_on)
-        rd.write_json(name, out)
+        out = evaluate_run(rd.path, robot, args.seconds, args.seeds, **common)
+    kind = "robustness" if args.perturb else "evaluation"
+    rd.write_json(_result_name(kind, args, learned_on), out)
     emit(out, args.json)
     return 0
 

@@ -23,7 +23,7 @@ from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.refine import refine_params, refine_per_scale
 from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
-from imitwalk.retarget.walkable import build_walkable
+from imitwalk.retarget.walkable import build_walkable, off_grid
 from imitwalk.robots import Robot
 
 __all__ = [
@@ -148,8 +148,7 @@ def retarget(
         raise unknown_name("mapping", cfg.mapping, MAPPINGS, ConfigError)
     sc = cfg.search_config
     if cfg.search and sc.refine_rounds and sc.refine_per_scale:
-        off = [x for x in sc.refine_scales if not np.isclose(cfg.scales, x, atol=1e-9).any()]
-        if off:
+        if off := off_grid(cfg.scales, sc.refine_scales):
             grid = ", ".join(f"{x:g}" for x in cfg.scales)
             raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
     template = extract_template(motion)
@@ -179,7 +178,13 @@ def retarget(
             if sc.refine_rounds:
                 how = refine_per_scale if sc.refine_per_scale else refine_params
                 out, report["refine"] = how(
-                    template, robot, params, sc, dt, command=cfg.command, progress=refine_progress
+                    template,
+                    robot,
+                    params,
+                    sc,
+                    dt=dt,
+                    command=cfg.command,
+                    progress=refine_progress,
                 )
                 if sc.refine_per_scale:
                     own = out

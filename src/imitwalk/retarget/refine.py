@@ -222,17 +222,11 @@ def refine_params(
 
 
 def refine_per_scale(
-    template: GaitTemplate,
-    robot: Robot,
-    params: GaitParams,
-    config,
-    dt: float = 0.01,
-    base: SimOptions | None = None,
-    command: GaitCommand | None = None,
-    progress=None,
+    template: GaitTemplate, robot: Robot, params: GaitParams, config, progress=None, **kw
 ) -> tuple[dict[float, GaitParams], dict]:
     """:func:`refine_params` once per scale of ``config.refine_scales``, each judged at
-    that scale alone and starting from ``params``.
+    that scale alone and starting from ``params``; ``kw`` (``dt``, ``base``,
+    ``command``) and ``progress`` (counted over every scale) as there.
 
     Returns:
         ``{scale: kept parameters}`` and a JSON-able report: the summed falls, cost and
@@ -248,9 +242,7 @@ def refine_per_scale(
             progress(done[0], total, trial)
 
     for s in scales:
-        kept[s], rep = refine_params(
-            template, robot, params, config, dt, base, command, relay, at=s
-        )
+        kept[s], rep = refine_params(template, robot, params, config, progress=relay, at=s, **kw)
         reports.append(rep)
     out = {
         "method": "coordinate search on open-loop falls, one per scale",

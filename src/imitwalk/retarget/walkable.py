@@ -21,7 +21,7 @@ from imitwalk.retarget.reference import PLAN_KEYS, Reference, plan_arrays
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.robots import Robot
 
-__all__ = ["WalkableBuild", "build_walkable"]
+__all__ = ["WalkableBuild", "build_walkable", "off_grid"]
 
 
 @dataclass
@@ -31,6 +31,12 @@ class WalkableBuild:
     reference: Reference
     frames: int
     seconds: float
+
+
+def off_grid(grid, scales) -> list[float]:
+    """The ``scales`` that are not scales of ``grid`` (to within 1e-9)."""
+    g = np.asarray(grid, dtype=float)
+    return [float(s) for s in scales if not np.isclose(g, s, rtol=0.0, atol=1e-9).any()]
 
 
 def build_walkable(
@@ -60,12 +66,10 @@ def build_walkable(
     geom = leg_geometry(robot)
     scales = np.asarray(sorted(scales), dtype=float)
     command = command or GaitCommand()
-    own = {}
-    for s, p in (scale_params or {}).items():
-        near = np.flatnonzero(np.isclose(scales, s, rtol=0.0, atol=1e-9))
-        if not len(near):
-            raise ConfigError(f"scale_params at {s:g}: not a grid scale {scales.tolist()}")
-        own[float(scales[near[0]])] = p
+    scale_params = scale_params or {}
+    if off := off_grid(scales, scale_params):
+        raise ConfigError(f"scale_params at {off}: not a grid scale of {scales.tolist()}")
+    own = {float(scales[np.abs(scales - s).argmin()]): p for s, p in scale_params.items()}
     starts, loops, strides, resid, clipped, travel, motion = [], [], [], [], [], [], []
     plans: dict[str, list] = {k: [] for k in PLAN_KEYS}
     t0 = time.perf_counter()
