@@ -1,0 +1,209 @@
+"""The retargeting pipeline: a clip in, a reference out (:func:`retarget`).
+
+Two mappings: ``"walkable"`` (the default) solves a task-space gait plan by IK on the
+robot itself, with its few parameters found by trials in simulation; ``"paper"`` is
+the paper's own mapping (§2), IK on a human-sized copy of the robot's skeleton. This
+module runs the IK and the trials, so it imports MuJoCo (through the solvers).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.mocap.motion import Motion
+from imitwalk.retarget.cadence import with_cadence
+from imitwalk.retarget.command import GaitCommand
+from imitwalk.retarget.human import build_paper
+from imitwalk.retarget.plan import GaitParams
+from imitwalk.retarget.reference import Reference
+from imitwalk.retarget.refine import refine_params, refine_per_scale
+from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
+from imitwalk.retarget.template import GaitTemplate, extract_template
+from imitwalk.retarget.walkable import build_walkable, off_grid
+from imitwalk.robots import Robot
+
+__all__ = [
+    "MAPPINGS",
+    "RetargetConfig",
+    "RetargetResult",
+    "retarget",
+]
+
+MAPPINGS = ("walkable", "paper")
+
+
+@dataclass(frozen=True)
+class RetargetConfig:
+    """How a clip is retargeted.
+
+    Attributes:
+        mapping: ``"walkable"`` or ``"paper"``.
+        control_hz: rate of the output trajectory [Hz].
+        scales: stride scales the reference is solved at.
+        search: run the parameter search (else ``params`` is used as is).
+        params: reference parameters (the search's starting point).
+        search_config: the search's budget.
+        command: turn, sidestep, stride fraction and slope
+            (:class:`~imitwalk.retarget.command.GaitCommand`; default straight, level).
+        cadence: play the loop this many times as fast as the human walked
+            (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
+            the human's cadence). 1: the human's own. To have it searched instead, give
+            ``search_config.cadences`` (:func:`~imitwalk.retarget.search.search_cadence`).
+    """
+
+    CHOICES: ClassVar[dict] = {"mapping": MAPPINGS}
+
+    mapping: str = "walkable"
+    control_hz: float = 100.0
+    scales: tuple[float, ...] = tuple(round(0.1 * i, 2) for i in range(1, 11))
+    search: bool = True
+    params: GaitParams = field(default_factory=GaitParams)
+    search_config: SearchConfig = field(default_factory=SearchConfig)
+    cadence: float = 1.0
+    command: GaitCommand = field(default_factory=GaitCommand)
+
+
+@dataclass
+class RetargetResult:
+    """A reference and the figures that judge it (see :meth:`stats`)."""
+
+    reference: Reference
+    motion_frames: int
+    motion_fps: float
+    template: GaitTemplate
+    frames_solved: int
+    solve_seconds: float
+
+    def stats(self) -> dict:
+        """The figures ``imitwalk retarget --json`` prints."""
+        ref = self.reference
+        at_limit = sum(c["ticks"] for c in ref.clipped)
+        total = ref.residual_mm.size * len(ref.joint_names)
+        out = {
+            "frames": self.motion_frames,
+            "fps": self.motion_fps,
+            "cycles_found": len(self.template.cycles),
+            "cycle_period_s": self.template.period,
+            "human_stride_m": self.template.stride,
+            "human_speed_mps": self.template.speed,
+            "mapping": ref.mapping,
+            "reference_frames": int(ref.loops.shape[1]),
+            "cadence": float(ref.settings.get("cadence", 1.0)),
+            "reference_hz": 1.0 / ref.dt,
+            "ik_residual_mm_mean": float(ref.residual_mm.mean()),
+            "ik_residual_mm_max": float(ref.residual_mm.max()),
+            "clipped_fraction": at_limit / total if total else 0.0,
+            "clipped": ref.clipped,
+            "frames_per_second_solved": self.frames_solved / max(self.solve_seconds, 1e-9),
+            "params": ref.params,
+        }
+        if ref.scale_params:
+            out["scale_params"] = ref.scale_params
+        out.update({k: v for k, v in ref.checks.items() if k != "scale"})
+        if ref.search.get("best"):
+            s = ref.search
+            out["search"] = {k: s[k] for k in ("evaluations", "sim_seconds", "wall_seconds")}
+            out["search"]["best_score"] = s["best"]["score"]
+        if "refine" in ref.search:
+            r = ref.search["refine"]
+            keys = ("scales", "start_falls", "falls", "sim_seconds", "wall_seconds")
+            out["refine"] = {k: r[k] for k in keys}
+            out["refine"]["runs_per_trial"] = r["trials"][0]["robots"]
+            out["refine"]["trials"] = len(r["trials"])
+        if "cadence" in ref.search:
+            out["cadence_search"] = ref.search["cadence"]
+        return out
+
+
+def retarget(
+    motion: Motion,
+    robot: Robot,
+    config: RetargetConfig | None = None,
+    progress=None,
+    refine_progress=None,
+) -> RetargetResult:
+    """Retarget ``motion`` to ``robot``.
+
+    Args:
+        motion: a loaded clip (see :func:`imitwalk.mocap.load_motion`).
+        robot: the robot.
+        config: settings; progress: optional ``callback(generation, total, score, params)``
+            for the parameter search; refine_progress: optional ``callback(done, total,
+            trial)`` for its refinement (``search_config.refine_rounds``).
+
+    Raises:
+        MocapError: the clip has no walking cycle. ConfigError: bad settings.
+    """
+    cfg = config or RetargetConfig()
+    if cfg.mapping not in MAPPINGS:
+        raise unknown_name("mapping", cfg.mapping, MAPPINGS, ConfigError)
+    sc = cfg.search_config
+    if cfg.search and sc.refine_rounds and sc.refine_per_scale:
+        if off := off_grid(cfg.scales, sc.refine_scales):
+            grid = ", ".join(f"{x:g}" for x in cfg.scales)
+            raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
+    template = extract_template(motion)
+    dt = 1.0 / cfg.control_hz
+    t0 = time.perf_counter()
+    if cfg.mapping == "paper" and not cfg.command.straight:
+        raise ConfigError("a turn, sidestep, stride fraction or slope needs mapping=walkable")
+    searched_cadence = cfg.search and cfg.mapping == "walkable" and bool(cfg.search_config.cadences)
+    if searched_cadence and cfg.cadence != 1.0:
+        raise ConfigError("give either cadence or search_config.cadences, not both")
+    if cfg.mapping == "paper":
+        ref = build_paper(motion, template, robot, cfg.scales, dt)
+        frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
+        report = {}
+    else:
+        params, report, own = cfg.params, {}, None
+        if cfg.search:
+            params, report = search_params(
+                template,
+                robot,
+                cfg.search_config,
+                cfg.params,
+                dt,
+                progress=progress,
+                command=cfg.command,
+            )
+            if sc.refine_rounds:
+                how = refine_per_scale if sc.refine_per_scale else refine_params
+                out, report["refine"] = how(
+                    template,
+                    robot,
+                    params,
+                    sc,
+                    dt=dt,
+                    command=cfg.command,
+                    progress=refine_progress,
+                )
+                if sc.refine_per_scale:
+                    own = out
+                else:
+                    params = out
+        build = build_walkable(
+            template, robot, params, cfg.scales, dt, command=cfg.command, scale_params=own
+        )
+        ref, frames, seconds = build.reference, build.frames, build.seconds
+    ref.search = report
+    ref.source = motion.source
+    ref.cycles = np.array(template.cycles, dtype=int).reshape(-1, 2)
+    ref.settings = {
+        "mapping": cfg.mapping,
+        "control_hz": cfg.control_hz,
+        "scales": list(cfg.scales),
+        "search": cfg.search,
+        "motion_format": motion.format,
+        "motion_fps": motion.fps,
+        "filled": list(motion.filled),
+    }
+    rate = cfg.cadence
+    if searched_cadence:
+        rate, ref.search["cadence"] = search_cadence(ref, robot, cfg.search_config)
+    ref = with_cadence(ref, rate)
+    return RetargetResult(ref, motion.n_frames, motion.fps, template, frames, seconds)
