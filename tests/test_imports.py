@@ -49,3 +49,12 @@ def test_numpy_stages_and_the_run_folder_import_without_mujoco():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr.strip().splitlines()[-1]
+
+
+def test_the_retarget_package_names_every_lazy_name_once():
+    import imitwalk.retarget as pkg
+
+    assert sorted(pkg.__all__) == sorted(pkg._HOME)
+    for name in pkg.__all__:
+        assert getattr(pkg, name) is not None
+    assert not hasattr(pkg, "no_such_name")  # an AttributeError, as for any module

@@ -28,7 +28,8 @@ __all__ = [
     "retarget",
 ]
 
-#: Where each public name lives (a submodule of this package).
+#: Where each public name lives (a submodule of this package). ``__all__`` above lists the
+#: same names as a literal, which static tools need; ``test_imports`` checks they agree.
 _HOME = {
     "MAPPINGS": "pipeline",
     "GaitCommand": "command",
