@@ -105,6 +105,9 @@ class StepController:
         explore: noise amplitude, a fraction of ``c_max``; scale: the stride scale (an
             input of the step model); target: ``(d,)`` mirrored step state the objective
             pulls towards (see :func:`step_target`).
+        ramp: ``(K,)`` the first K steps' strides, a fraction of a steady one (the
+            start-up's; later steps: 1). The step model sees ``scale × ramp[k]`` as step
+            k's stride scale (``None``: ``scale`` for every step).
     """
 
     def __init__(
@@ -118,8 +121,10 @@ class StepController:
         scale: float = 1.0,
         target: np.ndarray | None = None,
         limits: np.ndarray | None = None,
+        ramp: np.ndarray | None = None,
     ):
         self.config, self.n, self.ds, self.scale = config, n_ticks, ds, scale
+        self.ramp = np.ones(0) if ramp is None else np.asarray(ramp, dtype=float)
         dim = len(config.state_names)
         self.target = np.zeros(dim) if target is None else np.asarray(target, float)
         self.model, self.rng, self.explore = model, rng, explore
@@ -145,7 +150,8 @@ class StepController:
         base = self.offset
         c = base.copy()
         if self.model is not None and len(self.states) >= 2 and len(self.actions) >= 1:
-            c, pred = self._search(s, self.states[-2], np.r_[self.actions[-1], self.scale])
+            c_prev = np.r_[self.actions[-1], self.scale_of(k - 1)]
+            c, pred = self._search(s, self.states[-2], c_prev, k)
             c = base + self.config.gain * (c - base)
             self.predicted.append(pred)
         if self.rng is not None and self.explore > 0:
@@ -156,7 +162,7 @@ class StepController:
         self.actions.append(c)
         return c
 
-    def _search(self, s, s_prev, c_prev) -> tuple[np.ndarray, float]:
+    def _search(self, s, s_prev, c_prev, k: int) -> tuple[np.ndarray, float]:
         cfg = self.config
         rng = np.random.default_rng(len(self.states))
         lo = np.maximum(-self.box, self.c_min)
@@ -170,7 +176,7 @@ class StepController:
         seq = np.zeros((len(cand), cfg.horizon, len(STEP_CHANNELS) + 1))
         seq[:, 0, :-1] = cand
         seq[:, 1:, :-1] = base  # later steps: the nominal channels
-        seq[:, :, -1] = self.scale  # the model also sees the stride scale
+        seq[:, :, -1] = [self.scale_of(k + h) for h in range(cfg.horizon)]  # stride scale
         pred = self.model.rollout_members(s, s_prev, seq, c_prev)  # (E, M, H, ds)
         w = cfg.state_weights
         scale = np.where(self.c_max > 0, self.c_max, 1.0)
@@ -182,6 +188,10 @@ class StepController:
         if worst[best] > -cfg.margin * cost[:, 0].mean():  # not a clear enough gain
             best = 0
         return cand[best], float(cost[:, best].mean())
+
+    def scale_of(self, k: int) -> float:
+        """The stride scale step ``k`` is labelled with: ``scale`` × its ramp fraction."""
+        return self.scale * (float(self.ramp[k]) if 0 <= k < len(self.ramp) else 1.0)
 
     def rate(self, k: int) -> float:
         """How fast step ``k`` plays the plan: 1 / (1 + ``time``) loop ticks per control
@@ -198,7 +208,8 @@ class StepController:
         if k == 0:  # the robot fell before its first step decision
             dim = len(self.config.state_names)
             return np.zeros((0, dim)), np.zeros((0, len(STEP_CHANNELS) + 1))
-        acts = np.c_[np.asarray(self.actions[:k]).reshape(k, -1), np.full(k, self.scale)]
+        scales = [self.scale_of(i) for i in range(k)]
+        acts = np.c_[np.asarray(self.actions[:k]).reshape(k, -1), scales]
         return np.asarray(self.states[:k]).reshape(k, -1), acts
 
     def offsets(self, i: int) -> np.ndarray:

@@ -19,7 +19,7 @@ from imitwalk.ensemble import ModelEnsemble
 from imitwalk.errors import RunError
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
-from imitwalk.policy import WalkPolicy
+from imitwalk.policy import WalkPolicy, startup_ramp
 from imitwalk.predictor import SensoryMotorModel
 
 __all__ = [
@@ -161,6 +161,7 @@ def build_policy(
                 else None
             ),
             limits=step_limits(models, config),
+            ramp=startup_ramp(gait, scale) if config.step.ramp_scale else None,
         )
     return WalkPolicy(
         gait,

@@ -17,6 +17,8 @@ linearly). It records what the learner trains on.
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 
 from imitwalk.balance import StepController
@@ -26,7 +28,34 @@ from imitwalk.estimator import StateEstimator
 from imitwalk.gait import GaitModel
 from imitwalk.stepconfig import LAG_JOINTS
 
-__all__ = ["WalkPolicy"]
+__all__ = ["WalkPolicy", "startup_ramp", "step_clock0"]
+
+
+def step_clock0(gait: GaitModel) -> int:
+    """The plan tick of the balance channels' first step: the start-up's first step when
+    the start-up steps at the loop's cadence, else (a reference at another cadence) the
+    loop's first tick."""
+    m, n = gait.ref.starts.shape[1], gait.n_ticks
+    same = float(gait.ref.settings.get("cadence", 1.0)) == 1.0
+    return m % n + n if same else m
+
+
+def startup_ramp(gait: GaitModel, scale: float) -> np.ndarray:
+    """``(K,)`` each step's stride while the start-up's stride grows, a fraction of a
+    steady step's: the mean speed of the reference plan's walking frame over the step
+    over its mean speed along the loop (K: the steps that begin in the start-up; ones if
+    the frame does not travel, e.g. turning on the spot)."""
+    path = gait.ref.plan_at(scale)["path"]
+    n, half = gait.n_ticks, gait.n_ticks / 2.0
+    speed = np.hypot(np.diff(path[:, 3]), np.diff(path[:, 4]))  # [m / tick]
+    steady = speed[-n:].mean()
+    c0, m = step_clock0(gait), gait.ref.starts.shape[1]
+    n_steps = max(int(np.ceil((m - c0) / half)), 0)
+    if steady <= 1e-9:
+        return np.ones(n_steps)
+    edges = c0 + half * np.arange(n_steps + 1)
+    fractions = [speed[int(a) : int(b)].mean() / steady for a, b in pairwise(edges)]
+    return np.clip(fractions, 0.0, 1.0)
 
 
 class WalkPolicy:
@@ -60,11 +89,7 @@ class WalkPolicy:
         self.explore, self.rng = np.asarray(explore, dtype=float), rng
         self.start, self.loop, _ = gait.ref.at_scale(scale)
         self.n = gait.n_ticks
-        m = len(self.start)
-        # the balance channels' step clock: from the start-up's first step when the start-up
-        # steps at the loop's cadence, else (a reference at another cadence) from the loop
-        same = float(gait.ref.settings.get("cadence", 1.0)) == 1.0
-        self._clock0 = m % self.n + self.n if same else m
+        self._clock0 = step_clock0(gait)  # the balance channels' step clock starts here
         self.estimator = StateEstimator(gait.ref.dt)
         nom = gait.nominal[gait._key(scale)]
         self._phi_table = nom[:, 0]

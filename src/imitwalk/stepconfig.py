@@ -90,6 +90,10 @@ class StepConfig:
             0) that every step takes before the search's correction: the search's nominal
             candidate, the centre of its box and of the exploration noise. The learner
             picks it from measured trials (``LearnConfig.offsets``); units as ``c_max``.
+        ramp_scale: the step model's stride-scale input follows the start-up: a step of
+            the start-up, whose stride is still growing, is labelled with the schedule
+            scale × its stride's fraction of a steady one (off: every step is labelled
+            with the schedule scale, as in the first releases).
     """
 
     channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
@@ -106,6 +110,7 @@ class StepConfig:
     gain: float = 1.0
     servo_state: bool = False
     offset: tuple[float, ...] = ()
+    ramp_scale: bool = False
 
     @property
     def state_names(self) -> tuple[str, ...]:
