@@ -202,6 +202,16 @@ def test_cli_learn_and_evaluate(tmp_path, capsys, tiny_reference):
     assert main(argv) == 0
     at = json.loads(capsys.readouterr().out)
     assert at["settings"]["scale"] == 0.3 and RunDir(out).exists("evaluation_scale0.3.json")
+    # judged with another channel gain: gain 0 is the reference played open loop
+    rd.write_json("metrics.json", {**rd.read_json("metrics.json"), "cadence": 1.0})
+    assert main([*argv[:-2], "--gain", "0"]) == 0
+    g0 = json.loads(capsys.readouterr().out)
+    assert g0["settings"]["channel_gain"] == 0.0 and rd.exists("evaluation_gain0.json")
+    for a, b in zip(g0["learned"]["per_seed"], g0["open_loop"]["per_seed"], strict=True):
+        assert a["progress_ratio"] == pytest.approx(b["progress_ratio"], abs=1e-6)
+    assert main([*argv[:-2], "--gain", "3"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "0 <= gain <= 2" in err and len(err.splitlines()) == 1
 
 
 def test_evaluate_a_folder_that_is_not_a_run(tmp_path, capsys):

@@ -149,6 +149,12 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument(
         "--scale", type=float, default=None, help="judge at this scale (default: the one reached)"
     )
+    ev.add_argument(
+        "--gain",
+        type=float,
+        default=None,
+        help="the learned controller's channel gain, 0-2 (default: the one its trials kept)",
+    )
     ev.add_argument("--perturb", action="store_true", help="run the robustness grid instead")
     ev.add_argument("--robot", default=None, help="robot (default: the run's)")
     ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")

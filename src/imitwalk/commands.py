@@ -241,10 +241,11 @@ def learn(args: argparse.Namespace) -> int:
 
 
 def evaluate(args: argparse.Namespace) -> int:
-    from imitwalk.evaluate import evaluate_run
+    from imitwalk.evaluate import check_gain, evaluate_run
     from imitwalk.robustness import robustness_grid
     from imitwalk.runs import RunDir
 
+    check_gain(args.gain)
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     ref_settings = cfg.get("reference", {})
@@ -253,6 +254,7 @@ def evaluate(args: argparse.Namespace) -> int:
     args.engine = args.engine or learned_on
     robot = robot_from(args)
     common = {"workers": args.workers, "scale": args.scale, "engine": args.engine}
+    common["gain"] = args.gain
     if args.perturb:
         progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
         out = robustness_grid(rd.path, robot, args.seconds, args.seeds, progress=progress, **common)
@@ -266,11 +268,12 @@ def evaluate(args: argparse.Namespace) -> int:
 
 
 def _result_name(kind: str, args: argparse.Namespace, learned_on: str) -> str:
-    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_bullet.json`` (on
-    another engine than the run learned on) ..."""
+    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_gain0.25.json``,
+    ``evaluation_bullet.json`` (on another engine than the run learned on) ..."""
     scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    gain = "" if args.gain is None else f"_gain{args.gain:g}"
     engine = "" if args.engine == learned_on else f"_{args.engine}"
-    return f"{kind}{scale}{engine}.json"
+    return f"{kind}{scale}{gain}{engine}.json"
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -13,6 +13,7 @@ from dataclasses import replace
 
 from scipy.stats import binomtest
 
+from imitwalk.errors import ConfigError
 from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.metrics import summarise, walk_metrics
@@ -25,7 +26,15 @@ from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim import SimOptions, make_plant, playback, run
 
-__all__ = ["LearnedGait", "compare_falls", "evaluate_run", "load_gait", "per_seed", "wilson"]
+__all__ = [
+    "LearnedGait",
+    "check_gain",
+    "compare_falls",
+    "evaluate_run",
+    "load_gait",
+    "per_seed",
+    "wilson",
+]
 
 KEYS = (
     "forward_distance_m",
@@ -56,10 +65,14 @@ class LearnedGait:
         self.gait = GaitModel(played, config.schedule.scales(), config.gait)
         self.models = fit_models(data, config)
 
-    def policy(self, robot: Robot, scale: float | None = None):
-        """A fresh controller (no exploration) at ``scale`` (default: the scale reached)."""
+    def policy(self, robot: Robot, scale: float | None = None, gain: float | None = None):
+        """A fresh controller (no exploration) at ``scale`` (default: the scale reached),
+        with the channel gain ``gain`` (default: the one the run's trials kept)."""
         s = self.scale if scale is None else scale
-        return build_policy(self.gait, s, self.config, self.models, robot=robot)
+        cfg = self.config
+        if gain is not None:
+            cfg = replace(cfg, step=replace(cfg.step, gain=float(gain)))
+        return build_policy(self.gait, s, cfg, self.models, robot=robot)
 
 
 def load_gait(run_dir) -> LearnedGait:
@@ -76,8 +89,14 @@ def load_gait(run_dir) -> LearnedGait:
 _CACHE: dict = {}
 
 
+def check_gain(gain: float | None) -> None:
+    """A one-line :class:`ConfigError` unless ``gain`` is ``None`` or in 0..2."""
+    if gain is not None and not 0.0 <= gain <= 2.0:
+        raise ConfigError(f"channel gain {gain:g}: expected 0 <= gain <= 2 (StepConfig.gain)")
+
+
 def _one(job) -> dict:
-    run_dir, robot, mode, seed, seconds, base, scale, factors, engine = job
+    run_dir, robot, mode, seed, seconds, base, scale, factors, engine, gain = job
     # a worker keeps the last run it loaded, until that run's metrics.json changes
     key = (str(run_dir), RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
@@ -90,7 +109,7 @@ def _one(job) -> dict:
     steps = round(seconds / ref.dt)
     q_ref = ref.trajectory(scale, seconds)
     if mode == "learned":
-        ro = run(make_plant(robot, opts, engine), lg.policy(robot, scale), steps)
+        ro = run(make_plant(robot, opts, engine), lg.policy(robot, scale, gain), steps)
     else:
         ro = playback(make_plant(robot, opts, engine), q_ref, q0=q_ref[0])
     m = walk_metrics(
@@ -113,12 +132,15 @@ def per_seed(
     scale=None,
     factors: tuple[str, ...] = FACTORS,
     engine: str = "mujoco",
+    gain: float | None = None,
 ) -> dict[str, list[dict]]:
     """Per-seed metrics of each mode (``factors``: what the perturbed robots differ in,
     see :func:`imitwalk.perturb.perturbed`; ``engine``: one of
-    :data:`imitwalk.sim.ENGINES`)."""
+    :data:`imitwalk.sim.ENGINES`; ``gain``: the learned controller's channel gain instead
+    of the one the run kept)."""
+    check_gain(gain)
     jobs = [
-        (str(run_dir), robot, mode, s, seconds, base, scale, tuple(factors), engine)
+        (str(run_dir), robot, mode, s, seconds, base, scale, tuple(factors), engine, gain)
         for mode in modes
         for s in seeds
     ]
@@ -196,17 +218,20 @@ def evaluate_run(
     base: SimOptions | None = None,
     scale: float | None = None,
     engine: str = "mujoco",
+    gain: float | None = None,
 ) -> dict:
     """``{"learned": ..., "open_loop": ...}`` with the same keys (per-seed figures as
     ``{"mean", "min", "max"}``); open loop is the reference at the same scale.
     ``"comparison"`` holds the paired fall comparison (:func:`compare_falls`).
     ``scale``: judge both at this scale instead of the one the run reached.
     ``engine``: the physics engine both are judged on (:data:`imitwalk.sim.ENGINES`),
-    whichever the run learned on."""
+    whichever the run learned on. ``gain``: the learned controller's channel gain
+    (``StepConfig.gain``) instead of the one the run's trials kept."""
     metrics = RunDir(run_dir).read_json("metrics.json")
     res = per_seed(
-        run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale, engine=engine
-    )
+        run_dir, robot, seconds, list(range(seeds)), base, workers, scale=scale, engine=engine,
+        gain=gain,
+    )  # fmt: skip
     out = {mode: _summary(runs, metrics) for mode, runs in res.items()}
     out["open_loop"]["sim_seconds_used_for_learning"] = 0.0
     out["open_loop"]["wall_seconds_for_learning"] = 0.0
@@ -219,5 +244,6 @@ def evaluate_run(
         "seeds": seeds,
         "scale": scale or metrics.get("scale_reached"),
         "engine": engine,
+        "channel_gain": metrics.get("channel_gain") if gain is None else gain,
     }
     return out

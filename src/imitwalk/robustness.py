@@ -60,9 +60,11 @@ def robustness_grid(
     cells: tuple[str, ...] | None = None,
     scale: float | None = None,
     engine: str = "mujoco",
+    gain: float | None = None,
 ) -> dict:
     """Survival and distance per cell, learned vs open loop (at ``scale``, default the
-    scale the run reached), on ``engine`` (:data:`imitwalk.sim.ENGINES`).
+    scale the run reached), on ``engine`` (:data:`imitwalk.sim.ENGINES`); ``gain``: the
+    learned controller's channel gain instead of the one the run's trials kept.
 
     Returns:
         ``{"cells": {name: {"learned": {...}, "open_loop": {...}}}, "totals": {...}}`` where
@@ -71,7 +73,8 @@ def robustness_grid(
     """
     grid = _cells(seconds)
     names = cells or tuple(grid)
-    out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine, "cells": {}}
+    out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine}
+    out.update(channel_gain=gain, cells={})
     for name in names:
         res = per_seed(
             run_dir,
@@ -82,6 +85,7 @@ def robustness_grid(
             workers,
             scale=scale,
             engine=engine,
+            gain=gain,
         )
         row = {}
         for mode, runs in res.items():
