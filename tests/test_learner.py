@@ -211,7 +211,7 @@ def test_cli_learn_and_evaluate(tmp_path, capsys, tiny_reference):
         assert a["progress_ratio"] == pytest.approx(b["progress_ratio"], abs=1e-6)
     assert main([*argv[:-2], "--gain", "3"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "0 <= gain <= 2" in err and len(err.splitlines()) == 1
+    assert "step.gain=3.0: expected 0 <= gain <= 2" in err and len(err.splitlines()) == 1
 
 
 def test_evaluate_a_folder_that_is_not_a_run(tmp_path, capsys):

@@ -15,6 +15,7 @@ import numpy as np
 
 from imitwalk.evaluate import per_seed
 from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
 from imitwalk.sim import SimOptions
 
 __all__ = ["CELLS", "robustness_grid"]
@@ -74,7 +75,8 @@ def robustness_grid(
     grid = _cells(seconds)
     names = cells or tuple(grid)
     out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine}
-    out.update(channel_gain=gain, cells={})
+    kept = RunDir(run_dir).read_json("metrics.json").get("channel_gain")
+    out.update(channel_gain=kept if gain is None else gain, cells={})
     for name in names:
         res = per_seed(
             run_dir,
