@@ -35,6 +35,13 @@ def one_robot(ref: Reference, robot, scale: float, seed: int, seconds: float, ab
     plant = MujocoPlant(robot, perturbed(seed, ref.sim_options(None), disturbance=seed != 0))
     model, data = plant.model, plant.data
     names = list(ref.joint_names)
+    # per side: is each loop tick mid-swing; the knee's index; the sole's geom and body
+    mid = {
+        s: plan[v[0]][m : m + n, 2] >= above * plan[v[0]][m : m + n, 2].max()
+        for s, v in SIDES.items()
+    }
+    knee = {s: names.index(v[2]) for s, v in SIDES.items()}
+    ids = {s: (model.geom(v[1]).id, model.body(v[1]).id) for s, v in SIDES.items()}
     acc = {
         s: {"mid_swing_ticks": 0, "touching": 0, "outer": 0, "inner": 0, "lag": []} for s in SIDES
     }
@@ -42,16 +49,15 @@ def one_robot(ref: Reference, robot, scale: float, seed: int, seconds: float, ab
     def policy(k: int, obs) -> np.ndarray:
         t = k - 1  # the tick whose step produced this observation
         if t >= m + n:  # the steady loop, after its first cycle
-            ph = m + (t - m) % n
-            for s, (sole, body, knee, out_sign) in SIDES.items():
-                z = plan[sole][m : m + n, 2]
-                if plan[sole][ph, 2] < above * z.max():
+            ph = (t - m) % n
+            for s, (*_, out_sign) in SIDES.items():
+                if not mid[s][ph]:
                     continue
                 a = acc[s]
                 a["mid_swing_ticks"] += 1
-                j = names.index(knee)
+                j = knee[s]
                 a["lag"].append(q[t][j] - obs.joints[j])
-                gid, bid = model.geom(body).id, model.body(body).id
+                gid, bid = ids[s]
                 hit = [c for c in data.contact[: data.ncon] if gid in (c.geom1, c.geom2)]
                 if hit:
                     a["touching"] += 1
