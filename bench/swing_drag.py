@@ -66,7 +66,7 @@ def one_robot(ref: Reference, robot, scale: float, seed: int, seconds: float, ab
                     half = model.geom_size[gid][1]
                     a["outer"] += bool(out_sign * loc[1] > 0.6 * half)
                     a["inner"] += bool(out_sign * loc[1] < -0.6 * half)
-        return q[min(k, len(q) - 1)]
+        return q[k]  # run() calls k = 0 .. len(q) - 1
 
     ro = run(plant, policy, len(q), q0=q[0])
     out = {"seed": seed, "fell": bool(ro.fell), "fall_time_s": ro.fall_time}

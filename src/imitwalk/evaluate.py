@@ -31,6 +31,7 @@ __all__ = [
     "check_gain",
     "compare_falls",
     "evaluate_run",
+    "judged_gain",
     "load_gait",
     "per_seed",
     "wilson",
@@ -94,6 +95,12 @@ def check_gain(gain: float | None) -> None:
     valid ``StepConfig.gain``."""
     if gain is not None:
         StepConfig(gain=float(gain))  # its own check, its own message
+
+
+def judged_gain(metrics: dict, gain: float | None) -> float | None:
+    """The channel gain the learned controller is judged with: ``gain``, else the one the
+    run's trials kept (``metrics`` of its ``metrics.json``)."""
+    return metrics.get("channel_gain") if gain is None else float(gain)
 
 
 def _one(job) -> dict:
@@ -245,6 +252,6 @@ def evaluate_run(
         "seeds": seeds,
         "scale": scale or metrics.get("scale_reached"),
         "engine": engine,
-        "channel_gain": metrics.get("channel_gain") if gain is None else gain,
+        "channel_gain": judged_gain(metrics, gain),
     }
     return out

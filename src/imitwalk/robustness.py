@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from imitwalk.evaluate import per_seed
+from imitwalk.evaluate import judged_gain, per_seed
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim import SimOptions
@@ -75,8 +75,8 @@ def robustness_grid(
     grid = _cells(seconds)
     names = cells or tuple(grid)
     out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine}
-    kept = RunDir(run_dir).read_json("metrics.json").get("channel_gain")
-    out.update(channel_gain=kept if gain is None else gain, cells={})
+    metrics = RunDir(run_dir).read_json("metrics.json")
+    out.update(channel_gain=judged_gain(metrics, gain), cells={})
     for name in names:
         res = per_seed(
             run_dir,
