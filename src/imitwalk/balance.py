@@ -17,7 +17,10 @@ Channels (mirrored so that one model serves left and right steps):
 * ``time``: the step takes longer (> 0) or shorter (< 0) by this fraction of its nominal
   duration: the whole task-space plan, swing, sway and all, is played slower or faster
   over that step (:class:`imitwalk.policy.WalkPolicy` keeps the plan's clock). Off by
-  default (``step.channels`` names the channels in use).
+  default (``step.channels`` names the channels in use);
+* ``lift``: the swing foot rises higher (> 0) or lower (< 0) by this much at mid-swing
+  [m], a half-sine bump over the plan's swing window, so the sole is where the plan puts
+  it at lift-off and touch-down. Off by default.
 
 They act in task space: the landing offsets grow smoothly over the swing and decay over
 the foot's next stance, the sway is a half-sine bump over the step; the robot's IK
@@ -38,7 +41,15 @@ import numpy as np
 from imitwalk.controller import stability_cost
 from imitwalk.ensemble import ModelEnsemble
 from imitwalk.predictor import SensoryMotorModel
-from imitwalk.stepconfig import ALWAYS_DRAWN, LATERAL, STEP_CHANNELS, STEP_STATE, TIME, StepConfig
+from imitwalk.stepconfig import (
+    ALWAYS_DRAWN,
+    LATERAL,
+    LIFT,
+    STEP_CHANNELS,
+    STEP_STATE,
+    TIME,
+    StepConfig,
+)
 
 __all__ = [
     "STEP_CHANNELS",
@@ -72,12 +83,15 @@ def step_target(
 
 
 def upgrade_step_actions(A: np.ndarray) -> np.ndarray:
-    """Recorded step actions ``(K, 6)`` of a run written before the ``time`` channel →
-    ``(K, len(STEP_CHANNELS) + 1)``, with ``time`` 0 (it was nominal throughout); actions
-    of this release are returned as they are."""
-    if A.shape[1] != ALWAYS_DRAWN + 1:
-        return A
-    return np.insert(A, TIME, 0.0, axis=1)
+    """Recorded step actions of a run written before the ``time`` channel ``(K, 6)`` or
+    before the ``lift`` channel ``(K, 7)`` → ``(K, len(STEP_CHANNELS) + 1)``, with the
+    missing channels 0 (they were nominal throughout); actions of this release are
+    returned as they are."""
+    if A.shape[1] == ALWAYS_DRAWN + 1:
+        A = np.insert(A, TIME, 0.0, axis=1)
+    if A.shape[1] == LIFT + 1:
+        A = np.insert(A, LIFT, 0.0, axis=1)
+    return A
 
 
 def mirror_state(s: np.ndarray, m: float) -> np.ndarray:
@@ -213,7 +227,7 @@ class StepController:
         return np.asarray(self.states[:k]).reshape(k, -1), acts
 
     def offsets(self, i: int) -> np.ndarray:
-        """``(8,)`` task offsets at loop tick ``i`` (≥ 0), in ``retarget.ik.CHANNELS`` order.
+        """``(10,)`` task offsets at loop tick ``i`` (≥ 0), in ``retarget.ik.CHANNELS`` order.
 
         Call :meth:`decide` for step ``k = i // (N/2)`` before its first tick.
         """
@@ -226,7 +240,7 @@ class StepController:
         stance, swing = (0, 1) if k % 2 == 0 else (1, 0)
         m = 1.0 if stance == 0 else -1.0
         c = self.actions[k] if k < len(self.actions) else np.zeros(len(STEP_CHANNELS))
-        out = np.zeros(8)
+        out = np.zeros(10)
         # the stance foot's landing offset (from the previous step) decays over this step
         decay = 1.0 - _smooth(u)
         out[3 * stance : 3 * stance + 3] = self._land[stance] * decay
@@ -236,6 +250,7 @@ class StepController:
         out[6] = m * c[3] * np.sin(np.pi * u)
         prev = self.actions[k - 1][4] if 0 < k <= len(self.actions) else 0.0
         out[7] = prev + (c[4] - prev) * u
+        out[8 + swing] = c[LIFT] * np.sin(np.pi * sigma)  # 0 at lift-off and touch-down
         return out
 
     def _landing(self, k: int) -> np.ndarray:

@@ -66,7 +66,7 @@ class WalkPolicy:
         tick_selector: the paper's per-tick MPC (``None``: follow the nominal actions).
         tick_state: ``"gyro"`` (the paper) or ``"full"`` (gyro, roll, pitch) for its model.
         steps: the step-level channel controller (``None``: no channels).
-        channel_ik: ``(tick, offsets (8,)) -> (n,)`` joint angles of the reference plan with
+        channel_ik: ``(tick, offsets (10,)) -> (n,)`` joint angles of the reference plan with
             task offsets (zero offsets: the reference itself).
         explore: uniform noise on (r, h), a fraction of the tick box, during training.
         rng: noise source.

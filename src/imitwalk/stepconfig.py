@@ -18,6 +18,7 @@ __all__ = [
     "ALWAYS_DRAWN",
     "LAG_JOINTS",
     "LATERAL",
+    "LIFT",
     "SERVO_STATE",
     "STEP_CHANNELS",
     "STEP_STATE",
@@ -26,12 +27,14 @@ __all__ = [
 ]
 
 #: The channels, in the order of every channel vector (see :mod:`imitwalk.balance`).
-STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time")
+STEP_CHANNELS = ("dx", "dy", "yaw", "sway", "lean", "time", "lift")
 #: The channels of the first releases: their search candidates and exploration noise are
 #: always drawn (zero when off), so that runs written before ``time`` replay exactly.
 ALWAYS_DRAWN = 5
 #: Index of the ``time`` channel.
 TIME = STEP_CHANNELS.index("time")
+#: Index of the ``lift`` channel (the last; runs written before it have one value less).
+LIFT = STEP_CHANNELS.index("lift")
 #: Step state, in the stance side's mirrored frame.
 STEP_STATE = (
     "roll",
@@ -60,9 +63,9 @@ class StepConfig:
 
     Attributes:
         channels: which of :data:`STEP_CHANNELS` the learner may use (default: all but
-            ``time``).
+            ``time`` and ``lift``).
         c_max: box half-width per channel in :data:`STEP_CHANNELS` order
-            [m, m, rad, m, m, fraction of the step's duration].
+            [m, m, rad, m, m, fraction of the step's duration, m].
             ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
             apart, and a narrower step lands one foot on the other.
         weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
@@ -97,7 +100,7 @@ class StepConfig:
     """
 
     channels: tuple[str, ...] = ("dx", "dy", "yaw", "sway", "lean")
-    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15)
+    c_max: tuple[float, ...] = (0.015, 0.012, 0.04, 0.008, 0.01, 0.15, 0.005)
     weights: tuple[float, ...] = (20.0, 20.0, 2.0, 0.5, 0.5, 0.5, 0.0, 0.0)
     effort: float = 0.05
     horizon: int = 2
@@ -137,6 +140,9 @@ class StepConfig:
             c_max = list(self.c_max)
             c_max.insert(TIME, 0.0)
             object.__setattr__(self, "c_max", tuple(c_max))
+        for key in ("c_max", "offset"):  # a run written before the lift channel: lift 0
+            if len(getattr(self, key)) == LIFT:
+                object.__setattr__(self, key, (*getattr(self, key), 0.0))
         if len(self.c_max) != len(STEP_CHANNELS):
             raise ConfigError(
                 f"step.c_max has {len(self.c_max)} values: expected one per channel of "
@@ -144,6 +150,8 @@ class StepConfig:
             )
         if "time" in self.channels and not 0.0 <= self.c_max[TIME] < 0.5:
             raise ConfigError(f"step.c_max for time={self.c_max[TIME]}: expected 0 <= c < 0.5")
+        if "lift" in self.channels and not 0.0 <= self.c_max[LIFT] <= 0.02:
+            raise ConfigError(f"step.c_max for lift={self.c_max[LIFT]}: expected 0 <= c <= 0.02 m")
         if not 0.0 <= self.margin < 1.0:
             raise ConfigError(f"step.margin={self.margin}: expected 0 <= margin < 1")
         if len(self.weights) != len(STEP_STATE):

@@ -24,7 +24,7 @@ from imitwalk.robots import Robot
 __all__ = ["CHANNELS", "IKResult", "WalkIK", "leg_geometry"]
 
 #: Task-space offsets the IK can add to a plan's targets (see :meth:`WalkIK.solve_tick`).
-CHANNELS = ("l_x", "l_y", "l_yaw", "r_x", "r_y", "r_yaw", "com_y", "com_x")
+CHANNELS = ("l_x", "l_y", "l_yaw", "r_x", "r_y", "r_yaw", "com_y", "com_x", "l_z", "r_z")
 
 
 def _frame(model: mujoco.MjModel, name: str) -> tuple[str, int]:
@@ -152,7 +152,7 @@ class WalkIK:
         self.limits = [mink.ConfigurationLimit(m)]
 
     def _targets(self, plan: TaskPlan, i: int, base: np.ndarray, offset: np.ndarray) -> None:
-        """Set every task's target for tick ``i``; ``offset`` is ``(8,)`` in :data:`CHANNELS`."""
+        """Set every task's target for tick ``i``; ``offset`` is ``(10,)`` in :data:`CHANNELS`."""
         r, cfg = self.robot, self.cfg
         target_q = cfg.q.copy()
         for role, val in plan.upper.items():
@@ -167,7 +167,7 @@ class WalkIK:
             dx, dy, dyaw = offset[3 * k : 3 * k + 3]
             pose = np.eye(4)
             pose[:3, :3] = _rz(yaw[k] + dyaw) @ self._sole_rot[s]
-            pose[:3, 3] = sole[i] + np.r_[heading @ np.array([dx, dy]), 0.0]
+            pose[:3, 3] = sole[i] + np.r_[heading @ np.array([dx, dy]), offset[8 + k]]
             self.tasks[s].set_target(mink.SE3.from_matrix(pose))
         com = plan.com[i] + heading @ np.array([offset[7], offset[6]])
         self.com.set_target(np.array([com[0], com[1], 0.0]))
@@ -194,7 +194,7 @@ class WalkIK:
     def solve_tick(
         self, plan: TaskPlan, i: int, offset: np.ndarray, max_iter: int = 10
     ) -> np.ndarray:
-        """Joint angles ``(n,)`` [rad] for tick ``i`` of ``plan`` with task ``offset`` ``(8,)``
+        """Joint angles ``(n,)`` [rad] for tick ``i`` of ``plan`` with task ``offset`` ``(10,)``
         (:data:`CHANNELS`), warm-started from the previous call."""
         self._targets(plan, i, self.robot.stand, np.asarray(offset, dtype=float))
         self._converge(max_iter)

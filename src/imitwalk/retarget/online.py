@@ -1,8 +1,8 @@
 """Re-solving the walkable reference tick by tick, with task-space offsets.
 
 The balance channels (:mod:`imitwalk.balance`) move the swing foot's landing spot and
-the centre of mass in task space. :class:`OnlineIK` turns such offsets into joint
-angles exactly, by solving the reference's own task-space plan with the offsets added,
+height and the centre of mass in task space. :class:`OnlineIK` turns such offsets into
+joint angles exactly, by solving the reference's own task-space plan with the offsets added,
 warm-started from the previous tick (so zero offsets give back the reference). The
 controller only sees it as a function ``(tick, offsets) -> joint angles``.
 """
@@ -58,7 +58,7 @@ class OnlineIK:
 
     def __call__(self, k: float, offsets: np.ndarray) -> np.ndarray:
         """Joint angles [rad] at tick ``k`` (fractional: between two ticks) with
-        ``offsets`` ``(8,)`` in :data:`imitwalk.retarget.ik.CHANNELS` order."""
+        ``offsets`` ``(10,)`` in :data:`imitwalk.retarget.ik.CHANNELS` order."""
         it = 30 if self._fresh else 10
         self._fresh = False
         return self.ik.solve_tick(self._tick_plan(k), 0, offsets, max_iter=it)
