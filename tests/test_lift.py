@@ -73,3 +73,17 @@ def test_online_ik_raises_the_swing_sole_by_the_lift(robot, tiny_reference):
         zs[dz] = {s: _pos(ik.ik.model, d, robot.soles[s])[2] for s in "lr"}
     assert zs[0.004]["r"] - zs[0.0]["r"] == pytest.approx(0.004, abs=2e-4)
     assert zs[0.004]["l"] == pytest.approx(zs[0.0]["l"], abs=2e-4)
+
+
+def test_lift_offsets_can_be_tried_like_any_channel_offset():
+    from imitwalk.learnconfig import preset
+
+    step = StepConfig(channels=("dx", "dy", "yaw", "sway", "lean", "lift"))
+    cfg = preset("extended", step=step, offsets=(0.004,), offset_channel="lift")
+    assert cfg.with_offset(0.004).step.offset_vector[L] == 0.004
+    with pytest.raises(
+        ConfigError, match=r"step\.offset for lift=0\.008: outside -0\.005\.\.0\.005"
+    ):
+        preset("extended", step=step, offsets=(0.008,), offset_channel="lift")
+    with pytest.raises(ConfigError, match="unknown offset_channel 'lift'; valid: dx, dy"):
+        preset("extended", offsets=(0.004,), offset_channel="lift")
