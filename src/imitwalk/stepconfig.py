@@ -67,7 +67,8 @@ class StepConfig:
         c_max: box half-width per channel in :data:`STEP_CHANNELS` order
             [m, m, rad, m, m, fraction of the step's duration, m].
             ``dy`` only goes outwards: the feet of a HOAP-2-class robot pass a centimetre
-            apart, and a narrower step lands one foot on the other.
+            apart, and a narrower step lands one foot on the other. ``lift`` goes both
+            ways, by at most 0.02 m (the plan's swing is about 15 mm high).
         weights: λ per :data:`STEP_STATE` dimension of the step objective (eq. 6 extended),
             on the deviation from the target state (the walk's own mean state, heading 0).
         effort: weight of Σ ((c − offset) / c_max)² in the objective.

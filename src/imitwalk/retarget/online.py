@@ -2,9 +2,9 @@
 
 The balance channels (:mod:`imitwalk.balance`) move the swing foot's landing spot and
 height and the centre of mass in task space. :class:`OnlineIK` turns such offsets into
-joint angles exactly, by solving the reference's own task-space plan with the offsets added,
-warm-started from the previous tick (so zero offsets give back the reference). The
-controller only sees it as a function ``(tick, offsets) -> joint angles``.
+joint angles exactly, by solving the reference's own task-space plan with the offsets
+added, warm-started from the previous tick (so zero offsets give back the reference).
+The controller only sees it as a function ``(tick, offsets) -> joint angles``.
 """
 
 from __future__ import annotations
