@@ -1,5 +1,5 @@
 """Ablation: the extended learner with each extension switched off in turn (and the
-optional time channel switched on).
+optional time and lift channels switched on).
 
 For one clip's reference, learns with each variant and evaluates it on the 10
 evaluation robots (30 s, with the initial disturbance): at the scale it reached, and at
@@ -36,6 +36,7 @@ VARIANTS = {
     "no gain trials (gain 1)": ("extended", ["gains="]),
     "k = 3 components": ("extended", ["gait.n_components=3"]),
     "with the time channel (an addition)": ("extended", ["step.channels=dx,dy,yaw,sway,lean,time"]),
+    "with the lift channel (an addition)": ("extended", ["step.channels=dx,dy,yaw,sway,lean,lift"]),
     "faithful (the paper)": ("faithful", []),
 }
 
