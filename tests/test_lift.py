@@ -73,6 +73,10 @@ def test_online_ik_raises_the_swing_sole_by_the_lift(robot, tiny_reference):
         zs[dz] = {s: _pos(ik.ik.model, d, robot.soles[s])[2] for s in "lr"}
     assert zs[0.004]["r"] - zs[0.0]["r"] == pytest.approx(0.004, abs=2e-4)
     assert zs[0.004]["l"] == pytest.approx(zs[0.0]["l"], abs=2e-4)
+    # the step controller writes one offset per IK channel
+    ctrl = StepController(StepConfig(channels=("lift",)), N, DS)
+    ctrl.decide(np.zeros(len(STEP_STATE)), 0)
+    assert ctrl.offsets(0).shape == (len(CHANNELS),)
 
 
 def test_lift_offsets_can_be_tried_like_any_channel_offset():
