@@ -47,6 +47,7 @@ from imitwalk.stepconfig import (
     LIFT,
     STEP_CHANNELS,
     STEP_STATE,
+    TASK_OFFSETS,
     TIME,
     StepConfig,
 )
@@ -227,7 +228,8 @@ class StepController:
         return np.asarray(self.states[:k]).reshape(k, -1), acts
 
     def offsets(self, i: int) -> np.ndarray:
-        """``(10,)`` task offsets at loop tick ``i`` (≥ 0), in ``retarget.ik.CHANNELS`` order.
+        """``(len(TASK_OFFSETS),)`` task offsets at loop tick ``i`` (≥ 0), in
+        :data:`~imitwalk.stepconfig.TASK_OFFSETS` order.
 
         Call :meth:`decide` for step ``k = i // (N/2)`` before its first tick.
         """
@@ -240,7 +242,7 @@ class StepController:
         stance, swing = (0, 1) if k % 2 == 0 else (1, 0)
         m = 1.0 if stance == 0 else -1.0
         c = self.actions[k] if k < len(self.actions) else np.zeros(len(STEP_CHANNELS))
-        out = np.zeros(10)
+        out = np.zeros(len(TASK_OFFSETS))
         # the stance foot's landing offset (from the previous step) decays over this step
         decay = 1.0 - _smooth(u)
         out[3 * stance : 3 * stance + 3] = self._land[stance] * decay

@@ -22,6 +22,7 @@ __all__ = [
     "SERVO_STATE",
     "STEP_CHANNELS",
     "STEP_STATE",
+    "TASK_OFFSETS",
     "TIME",
     "StepConfig",
 ]
@@ -35,6 +36,10 @@ ALWAYS_DRAWN = 5
 TIME = STEP_CHANNELS.index("time")
 #: Index of the ``lift`` channel (the last; runs written before it have one value less).
 LIFT = STEP_CHANNELS.index("lift")
+#: The task-space offsets the channels turn into (per foot: landing x, y, yaw; the centre of
+#: mass y, x; per foot: swing height), in the order of every offset vector; the robot's
+#: IK adds them to its plan (:data:`imitwalk.retarget.ik.CHANNELS` is this tuple).
+TASK_OFFSETS = ("l_x", "l_y", "l_yaw", "r_x", "r_y", "r_yaw", "com_y", "com_x", "l_z", "r_z")
 #: Step state, in the stance side's mirrored frame.
 STEP_STATE = (
     "roll",

@@ -20,11 +20,13 @@ import numpy as np
 from imitwalk.errors import RetargetError
 from imitwalk.retarget.plan import LegGeometry, TaskPlan
 from imitwalk.robots import Robot
+from imitwalk.stepconfig import TASK_OFFSETS
 
 __all__ = ["CHANNELS", "IKResult", "WalkIK", "leg_geometry"]
 
-#: Task-space offsets the IK can add to a plan's targets (see :meth:`WalkIK.solve_tick`).
-CHANNELS = ("l_x", "l_y", "l_yaw", "r_x", "r_y", "r_yaw", "com_y", "com_x", "l_z", "r_z")
+#: Task-space offsets the IK can add to a plan's targets (see :meth:`WalkIK.solve_tick`):
+#: the ones the balance channels write (:data:`imitwalk.stepconfig.TASK_OFFSETS`).
+CHANNELS = TASK_OFFSETS
 
 
 def _frame(model: mujoco.MjModel, name: str) -> tuple[str, int]:
