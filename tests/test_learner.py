@@ -48,6 +48,18 @@ def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
     assert strip(la) == strip(lb)
 
 
+def test_stratified_trials_run_on_robots_that_cover_the_friction_range(
+    tmp_path, robot, tiny_reference
+):
+    from imitwalk.perturb import trial_seeds
+
+    ref, _ = tiny_reference
+    over = [*TINY, "train_models=2", "gain_robots=4", "gains=0,1", "stratify_trials=true"]
+    cfg = apply_overrides(preset("extended"), over)
+    trials = learn(ref, robot, cfg, tmp_path / "run")["gain_trials"]
+    assert trials["seeds"] == list(trial_seeds(4, True, (0.7, 1.0))) != list(trial_seeds(4))
+
+
 def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference):
     ref, _ = tiny_reference
     cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2"])

@@ -80,6 +80,30 @@ def test_trial_robots_are_neither_training_nor_evaluation_robots():
     assert trial_seeds(1) == (0,)
 
 
+@settings(max_examples=15, deadline=None)
+@given(
+    n=st.integers(3, 30),
+    lo=st.floats(0.3, 1.0),
+    width=st.floats(0.05, 0.6),
+)
+def test_stratified_trial_robots_cover_the_friction_range_one_per_band(n, lo, width):
+    from imitwalk.perturb import perturbed
+
+    hi = lo + width
+    seeds = trial_seeds(n, stratify=True, friction_range=(lo, hi))
+    assert seeds[0] == 0 and len(set(seeds)) == n and min(seeds[1:]) > TRIAL_SEED_BASE
+    assert seeds == trial_seeds(n, stratify=True, friction_range=(lo, hi))  # deterministic
+    f = [perturbed(s, disturbance=True, friction_range=(lo, hi)).friction for s in seeds[1:]]
+    bands = sorted(min(int((v - lo) / width * (n - 1)), n - 2) for v in f)
+    assert bands == list(range(n - 1))
+
+
+def test_unstratified_trial_robots_are_unchanged():
+    assert trial_seeds(5, stratify=False) == (0, *range(TRIAL_SEED_BASE + 1, TRIAL_SEED_BASE + 5))
+    assert trial_seeds(2, stratify=True) == trial_seeds(2)  # one band: nothing to stratify
+    assert trial_seeds(6, stratify=True, friction_range=(0.9, 0.9)) == trial_seeds(6)
+
+
 def test_a_mismatched_trial_list_is_refused():
     with pytest.raises(ValueError, match="one list of trials per candidate"):
         select_gain([0.0, 1.0], [[]])

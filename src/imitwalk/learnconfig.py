@@ -110,6 +110,9 @@ class LearnConfig:
             scale with it. The scale reached gets the same trials before the gain trials
             (once per scale). Empty: off.
         offset_channel: the channel those offsets are for (one of ``step.channels``).
+        stratify_trials: the ``gain_robots`` trial robots' floor frictions cover
+            ``train_friction`` evenly, one per band (:func:`imitwalk.perturb.trial_seeds`),
+            instead of being the first trial seeds' draws. Off by default.
         seed: random seed; workers: parallel processes (``None``: one per core).
         engine: the physics engine the robot learns on (:data:`imitwalk.simtypes.ENGINES`;
             ``bullet`` is about ten times slower than MuJoCo).
@@ -130,6 +133,7 @@ class LearnConfig:
     offset_channel: str = "dx"
     gain_robots: int = 12
     gain_seconds: float = 24.0
+    stratify_trials: bool = False
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"

@@ -261,7 +261,8 @@ def _tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, prog
         ]
         return [r["metrics"] for r in run_parallel(run_episode, jobs, config.workers)]
 
-    choice = tune_gain(episodes, values, trial_seeds(config.gain_robots), progress, key)
+    seeds = trial_seeds(config.gain_robots, config.stratify_trials, tuple(config.train_friction))
+    choice = tune_gain(episodes, values, seeds, progress, key)
     if progress:
         progress(f"{LABELS[key]} kept: {choice.gain:g}")
     return replace(choice, wall_seconds=time.perf_counter() - t0)

@@ -89,7 +89,34 @@ def train_seeds(n: int, draw: int = 0) -> tuple[int, ...]:
     return (0, *range(first, first + n - 1))
 
 
-def trial_seeds(n: int) -> tuple[int, ...]:
+def trial_seeds(
+    n: int, stratify: bool = False, friction_range: tuple[float, float] = (0.7, 1.0)
+) -> tuple[int, ...]:
     """``n`` robots for the gain trials: the nominal one, then ``n - 1`` perturbations that
-    neither learning nor evaluation uses."""
-    return (0, *range(TRIAL_SEED_BASE + 1, TRIAL_SEED_BASE + n))
+    neither learning nor evaluation uses.
+
+    Args:
+        n: how many robots.
+        stratify: pick the ``n - 1`` perturbed robots so that their floor frictions cover
+            ``friction_range`` evenly: one robot in each of ``n - 1`` equal bands of it,
+            the first trial seed (in order) whose draw falls in that band. Without it they
+            are the first ``n - 1`` trial seeds, whose frictions are whatever they drew (the
+            first 23 draw 14 below 0.8 and 4 above 0.94 of 0.7-1.0). A handful of robots
+            decides the trials, and the grippiest floors are where learned corrections
+            have hurt (README, "Why robots 5 and 9"); stratifying removes that luck of the
+            draw without choosing the robots by how they walk.
+        friction_range: the range the trial robots' friction is drawn from (the learner's
+            ``train_friction``).
+    """
+    lo, hi = friction_range
+    if not stratify or n <= 2 or hi <= lo:
+        return (0, *range(TRIAL_SEED_BASE + 1, TRIAL_SEED_BASE + n))
+    bands: list[int | None] = [None] * (n - 1)
+    seed = TRIAL_SEED_BASE
+    while None in bands:
+        seed += 1
+        f = perturbed(seed, disturbance=True, friction_range=(lo, hi)).friction
+        band = min(int((f - lo) / (hi - lo) * (n - 1)), n - 2)
+        if bands[band] is None:
+            bands[band] = seed
+    return (0, *sorted(bands))
