@@ -94,7 +94,7 @@ def test_stratified_trial_robots_cover_the_friction_range_one_per_band(n, lo, wi
     assert seeds[0] == 0 and len(set(seeds)) == n and min(seeds[1:]) > TRIAL_SEED_BASE
     assert seeds == trial_seeds(n, stratify=True, friction_range=(lo, hi))  # deterministic
     f = [perturbed(s, disturbance=True, friction_range=(lo, hi)).friction for s in seeds[1:]]
-    bands = sorted(min(int((v - lo) / width * (n - 1)), n - 2) for v in f)
+    bands = sorted(min(int((v - lo) / (hi - lo) * (n - 1)), n - 2) for v in f)
     assert bands == list(range(n - 1))
 
 
