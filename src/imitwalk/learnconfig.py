@@ -19,6 +19,7 @@ from typing import ClassVar
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.gait import GaitConfig
+from imitwalk.perturb import FRICTION_RANGE
 from imitwalk.simtypes import ENGINES
 from imitwalk.stepconfig import STEP_CHANNELS, StepConfig
 
@@ -126,7 +127,7 @@ class LearnConfig:
     step: StepConfig = field(default_factory=StepConfig)
     train_models: int = 3
     fresh_robots: bool = False
-    train_friction: tuple[float, float] = (0.7, 1.0)
+    train_friction: tuple[float, float] = FRICTION_RANGE
     gains: tuple[float, ...] = ()
     cadences: tuple[float, ...] = ()
     offsets: tuple[float, ...] = ()

@@ -21,6 +21,7 @@ from imitwalk.simtypes import SimOptions
 
 __all__ = [
     "FACTORS",
+    "FRICTION_RANGE",
     "TRAIN_SEED_BASE",
     "TRIAL_SEED_BASE",
     "perturbed",
@@ -31,6 +32,10 @@ __all__ = [
 #: What a perturbed robot differs in: body masses, floor friction, servo stiffness, and
 #: the initial push of the base (only drawn with ``disturbance=True``).
 FACTORS = ("mass", "friction", "servo", "disturbance")
+
+#: The range a perturbed robot's floor friction is drawn from (evaluation's, and by default
+#: the learner's ``train_friction``).
+FRICTION_RANGE = (0.7, 1.0)
 
 #: Seeds at or above this are reserved for learning and searching.
 TRAIN_SEED_BASE = 1000
@@ -44,7 +49,7 @@ def perturbed(
     base: SimOptions | None = None,
     disturbance: bool = False,
     factors: tuple[str, ...] = FACTORS,
-    friction_range: tuple[float, float] = (0.7, 1.0),
+    friction_range: tuple[float, float] = FRICTION_RANGE,
 ) -> SimOptions:
     """Simulation options of robot ``seed`` (0: nominal, as ``base``).
 
@@ -90,7 +95,7 @@ def train_seeds(n: int, draw: int = 0) -> tuple[int, ...]:
 
 
 def trial_seeds(
-    n: int, stratify: bool = False, friction_range: tuple[float, float] = (0.7, 1.0)
+    n: int, stratify: bool = False, friction_range: tuple[float, float] = FRICTION_RANGE
 ) -> tuple[int, ...]:
     """``n`` robots for the gain trials: the nominal one, then ``n - 1`` perturbations that
     neither learning nor evaluation uses.
