@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk import learner
+from imitwalk import tuning
 from imitwalk.balance import STEP_CHANNELS, STEP_STATE, StepConfig, StepController
 from imitwalk.errors import ConfigError
 from imitwalk.learnconfig import preset
@@ -101,25 +101,25 @@ def _fake_tune(kept: float, calls: list):
 
 def test_a_stalled_schedule_goes_on_with_the_offset_that_measures_better(monkeypatch):
     calls: list = []
-    monkeypatch.setattr(learner, "_tune", _fake_tune(-0.005, calls))
+    monkeypatch.setattr(tuning, "tune", _fake_tune(-0.005, calls))
     cfg = preset("extended", offsets=(-0.005, -0.0025, 0.0))
     state = {"failures": 7, "sim_seconds": 0.0, "wall_seconds": 0.0}
-    assert learner._retry_with_offset(None, None, cfg, {}, 0.9, state, None)
+    assert tuning.retry_with_offset(None, None, cfg, {}, 0.9, state, None)
     assert state["offset"] == -0.005 and state["failures"] == 0
     # the current value is tried first (it wins ties), then by distance from it
     assert calls == [(0.9, "offset", [0.0, -0.0025, -0.005], 0.0)]
     assert state["offset_trials"][0]["scale"] == 0.9 and state["sim_seconds"] == 48.0
     # once per scale: at 0.9 the schedule now stops; at 1.0 the trials start from -0.005
-    assert not learner._retry_with_offset(None, None, cfg, {}, 0.9, state, None)
-    monkeypatch.setattr(learner, "_tune", _fake_tune(-0.005, calls))
-    assert not learner._retry_with_offset(None, None, cfg, {}, 1.0, state, None)
+    assert not tuning.retry_with_offset(None, None, cfg, {}, 0.9, state, None)
+    monkeypatch.setattr(tuning, "tune", _fake_tune(-0.005, calls))
+    assert not tuning.retry_with_offset(None, None, cfg, {}, 1.0, state, None)
     assert calls[-1] == (1.0, "offset", [-0.005, -0.0025, 0.0], -0.005)
 
 
 def test_without_offsets_a_stalled_schedule_stops(monkeypatch):
-    monkeypatch.setattr(learner, "_tune", None)  # never called
+    monkeypatch.setattr(tuning, "tune", None)  # never called
     state = {"failures": 7}
-    assert not learner._retry_with_offset(None, None, preset("extended"), {}, 0.9, state, None)
+    assert not tuning.retry_with_offset(None, None, preset("extended"), {}, 0.9, state, None)
     assert state == {"failures": 7}
 
 

@@ -114,6 +114,12 @@ class LearnConfig:
         stratify_trials: the ``gain_robots`` trial robots' floor frictions cover
             ``train_friction`` evenly, one per band (:func:`imitwalk.perturb.trial_seeds`),
             instead of being the first trial seeds' draws. Off by default.
+        back_off_to: a scale, or ``None`` (off). If set, and the gain kept by the trials
+            at the top scale passed still falls on some trial robot, the same gain trials
+            run one passed scale lower; if the best gain there falls on fewer trial
+            robots, the walk settles there (and the search goes on lower while it still
+            falls), never below this scale. The scale settled at is ``scale_reached``
+            (:func:`imitwalk.tuning.back_off`). Needs ``gains``.
         seed: random seed; workers: parallel processes (``None``: one per core).
         engine: the physics engine the robot learns on (:data:`imitwalk.simtypes.ENGINES`;
             ``bullet`` is about ten times slower than MuJoCo).
@@ -135,6 +141,7 @@ class LearnConfig:
     gain_robots: int = 12
     gain_seconds: float = 24.0
     stratify_trials: bool = False
+    back_off_to: float | None = None
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"
@@ -164,6 +171,10 @@ class LearnConfig:
                 )
             for v in self.offsets:  # each candidate must be a valid step.offset
                 self._step_with_offset(v)
+        if self.back_off_to is not None and not (self.gains and self.steps):
+            raise ConfigError("back_off_to needs the gain trials: set gains (and steps=true)")
+        if self.back_off_to is not None and not 0.0 < self.back_off_to <= 2.0:
+            raise ConfigError(f"back_off_to={self.back_off_to}: expected a scale in 0..2")
         if (self.gains or self.cadences or self.offsets) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 

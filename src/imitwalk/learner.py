@@ -16,15 +16,19 @@ channel-gain trials then decide how much of the learned correction to apply, and
 are checkpointed too. After every
 iteration the run folder is checkpointed atomically, so ``resume`` continues an
 interrupted run and ends where an uninterrupted one would (same seed, same result).
+With ``back_off_to``, a run whose gain trials still fall at the top scale gives back
+scale where the same trials measure fewer falls (:func:`imitwalk.tuning.back_off`); the
+trials themselves run in :mod:`imitwalk.tuning`.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, replace
+from dataclasses import asdict
 
 import numpy as np
 
+from imitwalk import tuning
 from imitwalk.config import from_dict, to_dict
 from imitwalk.episode import run_episode
 from imitwalk.errors import RunError
@@ -32,13 +36,10 @@ from imitwalk.gait import GaitModel
 from imitwalk.learnconfig import LearnConfig
 from imitwalk.models import fit_models, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
-from imitwalk.perturb import train_seeds, trial_seeds
-from imitwalk.retarget.cadence import with_cadence
+from imitwalk.perturb import train_seeds
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
-from imitwalk.stepconfig import STEP_CHANNELS
-from imitwalk.trust import LABELS, tune_gain
 
 __all__ = ["learn"]
 
@@ -157,7 +158,7 @@ def learn(
             state["failures"] += 1
             state["clean"] = 0
             if state["failures"] > sch.retries:
-                state["done"] = not _retry_with_offset(
+                state["done"] = not tuning.retry_with_offset(
                     gait, robot, config, data, scale, state, progress
                 )
         elif last:
@@ -186,27 +187,31 @@ def learn(
         if progress:
             progress(_progress_line(entry))
     if config.offsets and state["passed"]:  # and at the scale reached (once per scale)
-        _retry_with_offset(gait, robot, config, data, max(state["passed"]), state, progress)
+        tuning.retry_with_offset(gait, robot, config, data, max(state["passed"]), state, progress)
         rd.write_json("checkpoint.json", state)
     run_cfg = config.with_offset(state.get("offset"))
+    top = max(state["passed"]) if state["passed"] else 0.0
     for key, values in (("gain", config.gains), ("cadence", config.cadences)):
         if values and config.steps and state["passed"] and key not in state:
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain
-            top = max(state["passed"])
-            choice = _tune(gait, robot, run_cfg, data, top, key, values, gain, progress)
+            choice = tuning.tune(gait, robot, run_cfg, data, top, key, values, gain, progress)
             state[key] = choice.to_dict()
             state["sim_seconds"] += choice.sim_seconds
             state["wall_seconds"] += choice.wall_seconds
             rd.write_json("checkpoint.json", state)
+        if key == "gain" and config.back_off_to is not None and "gain" in state:
+            top = tuning.back_off(gait, robot, config, data, state, progress)
+            rd.write_json("checkpoint.json", state)
     summary = {
         "variant": config.variant,
-        "scale_reached": max(state["passed"]) if state["passed"] else 0.0,
+        "scale_reached": top,
         "scales_passed": state["passed"],
         "iterations": state["total_iterations"],
         "sim_seconds_used_for_learning": state["sim_seconds"],
         "wall_seconds_for_learning": state["wall_seconds"],
         "channel_gain": state["gain"]["gain"] if "gain" in state else config.step.gain,
         "gain_trials": state.get("gain"),
+        "back_off": state.get("back_off"),
         "cadence": state["cadence"]["cadence"] if "cadence" in state else 1.0,
         "cadence_trials": state.get("cadence"),
         "channel_offset": (
@@ -218,54 +223,6 @@ def learn(
     }
     rd.write_json("metrics.json", summary)
     return summary
-
-
-def _retry_with_offset(gait, robot, config: LearnConfig, data, scale, state, progress) -> bool:
-    """The schedule would stop at ``scale``: try ``config.offsets`` there (once per scale).
-    True if another offset measured better; it is kept and the schedule goes on."""
-    if not (config.offsets and config.steps) or scale in state.get("offset_tried", []):
-        return False
-    state.setdefault("offset_tried", []).append(scale)
-    run_cfg = config.with_offset(state.get("offset"))
-    now = float(run_cfg.step.offset_vector[STEP_CHANNELS.index(config.offset_channel)])
-    values = sorted(set(config.offsets) | {now}, key=lambda v: (abs(v - now), v))  # ties: now
-    gain = run_cfg.step.gain
-    choice = _tune(gait, robot, run_cfg, data, scale, "offset", values, gain, progress)
-    state.setdefault("offset_trials", []).append({"scale": scale, **choice.to_dict()})
-    state["sim_seconds"] += choice.sim_seconds
-    state["wall_seconds"] += choice.wall_seconds
-    if choice.gain == now:
-        return False
-    state["offset"], state["failures"] = choice.gain, 0
-    return True
-
-
-def _tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progress):
-    """Trials at ``scale`` (:func:`imitwalk.trust.tune_gain`) of ``values`` of the channel
-    gain (``key="gain"``), of the cadence with the channel gain ``gain`` (``"cadence"``),
-    or of the channel offset with that gain (``"offset"``)."""
-    t0 = time.perf_counter()
-    models = fit_models(data, config)
-
-    def episodes(value: float, seeds) -> list[dict]:
-        g = value if key == "gain" else gain
-        rate = value if key == "cadence" else 1.0
-        cfg = config.with_offset(value) if key == "offset" else config
-        cfg = replace(cfg, step=replace(cfg.step, gain=g))
-        walk = gait  # the gait the schedule learned, at the candidate cadence
-        if rate != 1.0:
-            walk = GaitModel(with_cadence(gait.ref, rate), gait.scales, config.gait)
-        jobs = [
-            (robot, walk, scale, cfg, models, s, 0.0, [config.seed, 10**6, j], config.gain_seconds)
-            for j, s in enumerate(seeds)
-        ]
-        return [r["metrics"] for r in run_parallel(run_episode, jobs, config.workers)]
-
-    seeds = trial_seeds(config.gain_robots, config.stratify_trials, tuple(config.train_friction))
-    choice = tune_gain(episodes, values, seeds, progress, key)
-    if progress:
-        progress(f"{LABELS[key]} kept: {choice.gain:g}")
-    return replace(choice, wall_seconds=time.perf_counter() - t0)
 
 
 def _progress_line(e: dict) -> str:

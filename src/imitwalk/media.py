@@ -71,8 +71,11 @@ def outcome(ro: Rollout) -> str:
 
 def gain(metrics: dict) -> str:
     """The channel gain, cadence and channel offset of a run's ``metrics.json``, and their
-    trials if any ran, in a phrase (the offset only if it was tried)."""
+    trials if any ran, in a phrase (the offset only if it was tried; a back-off first)."""
     parts = []
+    back = metrics.get("back_off") or {}
+    if back and back["scale"] != back["from"]:
+        parts.append(f"backed off from scale {back['from']:g} to {back['scale']:g}")
     for key, label in LABELS.items():
         if key == "offset":  # one round of trials per scale where they ran, if any
             kept = metrics.get("channel_offset") or {}

@@ -183,13 +183,17 @@ def fig6_optimized(
 
 
 def fig7_schedule(
-    gait, scales_passed: Sequence[float], actions: np.ndarray | None = None
+    gait,
+    scales_passed: Sequence[float],
+    actions: np.ndarray | None = None,
+    reached: float | None = None,
 ) -> Figure:
     """Fig. 7: the pattern at each scale of the schedule in PC space (passed ones coloured,
-    the rest grey) and the reference's largest scale (the target) dashed. The last scale
-    passed is highlighted with red circles: on the last cycle of executed ``actions``
-    ``(T, 3)`` (φ, r, h) at that scale if given (the paper's optimisation result), else
-    on its reference loop."""
+    the rest grey) and the reference's largest scale (the target) dashed. The scale
+    reached (``reached``; default: the last scale passed, lower if the run backed off,
+    ``LearnConfig.back_off_to``) is highlighted with red circles: on the last cycle of
+    executed ``actions`` ``(T, 3)`` (φ, r, h) at that scale if given (the paper's
+    optimisation result), else on its reference loop."""
     passed = [float(s) for s in scales_passed]
     fig = _figure(6.5, 5.2)
     ax = fig.add_subplot(projection="3d")
@@ -205,13 +209,16 @@ def fig7_schedule(
         X = _closed(_pcs(gait, target))
         ax.plot(*X.T, color="k", ls="--", lw=1.0, label=f"target {target:g}")
     if passed:
-        final = max(passed)
+        final = max(passed) if reached is None else float(reached)
         A = np.asarray(actions if actions is not None else [], dtype=float).reshape(-1, 3)
         A = A[-gait.n_ticks :]
         X = gait.embedding(final).from_cylinder(A)[:, :3] if len(A) else _pcs(gait, final)
         X = X[:: max(1, len(X) // 30)]
         ax.scatter(*X.T, s=40, lw=1.5, label=f"reached {final:g}", **RINGS)
-        ax.set_title(f"Motion pattern scaling: reached {final:g} of the schedule")
+        title = f"Motion pattern scaling: reached {final:g} of the schedule"
+        if final < max(passed) - 1e-9:
+            title += f" (passed {max(passed):g}, backed off)"
+        ax.set_title(title)
     else:
         ax.set_title("Motion pattern scaling: no scale of the schedule was passed")
     _pc_labels(ax, gait)

@@ -190,7 +190,8 @@ def _sections(
 ) -> str:
     gait, scale, log, m = lg.gait, rp.scale, rd.read_log(), lg.metrics
     passed = [float(p) for p in m.get("scales_passed", [])]
-    at_final = bool(passed) and abs(max(passed) - scale) < 1e-9
+    reached = float(m.get("scale_reached") or (max(passed) if passed else 0.0))
+    at_final = bool(passed) and abs(reached - scale) < 1e-9
     evr = gait.subspace.explained_variance_ratio_
     if rd.exists("evaluation.json"):
         evaluation = _metrics_table(rd.read_json("evaluation.json"))
@@ -208,7 +209,7 @@ def _sections(
         rp.before.control_dt,
         fall_times=(rp.before.fall_time, rp.after.fall_time),
     )
-    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None)
+    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None, reached)
     sections = [
         (
             "Before and after",

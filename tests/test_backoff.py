@@ -1,0 +1,134 @@
+"""The back-off (``LearnConfig.back_off_to``): give back scale when the gain trials at the
+top scale still fall (:func:`imitwalk.tuning.back_off`)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import TINY
+from imitwalk import tuning
+from imitwalk.config import apply_overrides
+from imitwalk.errors import ConfigError
+from imitwalk.learnconfig import preset
+from imitwalk.trust import GainChoice
+
+GAINS = (0.0, 0.5, 1.0)
+
+
+def _trials(falls: tuple[int, ...], scale: float | None = None) -> dict:
+    """Gain trials as the learner keeps them: the best of ``falls`` (per gain) kept."""
+    table = [{"gain": g, "falls": f} for g, f in zip(GAINS, falls, strict=True)]
+    kept = GAINS[falls.index(min(falls))]
+    out = GainChoice(kept, (0, 100001), table, sim_seconds=60.0, wall_seconds=2.0).to_dict()
+    return out if scale is None else {"scale": scale, **out}
+
+
+def _fake_tune(falls_by_scale: dict, calls: list):
+    def tune(gait, robot, config, data, scale, key, values, gain, progress):
+        calls.append((scale, key, tuple(values)))
+        t = _trials(falls_by_scale[scale])
+        return GainChoice(t["gain"], tuple(t["seeds"]), t["table"], 60.0, 2.0, key)
+
+    return tune
+
+
+def _state(top_falls: tuple[int, ...]) -> dict:
+    passed = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
+    return {"passed": passed, "gain": _trials(top_falls), "sim_seconds": 0.0, "wall_seconds": 0.0}
+
+
+def test_kept_falls_reads_the_kept_gains_row():
+    assert tuning.kept_falls(_trials((2, 1, 4))) == 1
+    assert tuning.kept_falls(_trials((0, 3, 3))) == 0
+
+
+@pytest.mark.parametrize(
+    ("falls_by_scale", "floor", "settled", "tried"),
+    [
+        ({0.8: (3, 0, 2)}, 0.8, 0.8, [0.8]),  # fewer falls one scale down: settle there
+        ({0.8: (3, 2, 2)}, 0.8, 0.9, [0.8]),  # as many: keep the top (ties: higher scale)
+        ({0.8: (3, 1, 0), 0.7: (2, 0, 0)}, 0.7, 0.8, [0.8]),  # none fall at 0.8: stop there
+        ({0.8: (3, 2, 1), 0.7: (2, 0, 0)}, 0.7, 0.7, [0.8, 0.7]),  # still falls: go on lower
+        ({0.8: (3, 2, 1), 0.7: (2, 0, 0)}, 0.8, 0.8, [0.8]),  # never below back_off_to
+    ],
+)
+def test_back_off_settles_where_the_trials_fall_least(
+    monkeypatch, falls_by_scale, floor, settled, tried
+):
+    calls: list = []
+    monkeypatch.setattr(tuning, "tune", _fake_tune(falls_by_scale, calls))
+    cfg = preset("extended", gains=GAINS, back_off_to=floor)
+    state = _state((2, 2, 3))  # the kept gain falls on 2 trial robots at the top, 0.9
+    top_trials = state["gain"]
+    assert tuning.back_off(None, None, cfg, {}, state, None) == settled
+    assert [c[0] for c in calls] == tried and all(c[1:] == ("gain", GAINS) for c in calls)
+    record = state["back_off"]
+    assert record["from"] == 0.9 and record["scale"] == settled
+    assert [t["scale"] for t in record["trials"]] == tried
+    assert state["sim_seconds"] == 60.0 * len(tried)  # the trials' cost is counted
+    if settled == 0.9:
+        assert state["gain"] == top_trials
+    else:
+        assert state["gain"]["scale"] == settled
+        assert state["gain"]["gain"] == _trials(falls_by_scale[settled])["gain"]
+    # a second call (a resume after the back-off was checkpointed) runs no trials
+    assert tuning.back_off(None, None, cfg, {}, state, None) == settled
+    assert len(calls) == len(tried)
+
+
+def test_no_back_off_when_the_top_scale_walks_on_every_trial_robot(monkeypatch):
+    monkeypatch.setattr(tuning, "tune", None)  # never called
+    state = _state((1, 0, 2))
+    cfg = preset("extended", back_off_to=0.5)
+    assert tuning.back_off(None, None, cfg, {}, state, None) == 0.9
+    assert state["back_off"] == {"from": 0.9, "scale": 0.9, "trials": []}
+
+
+def test_back_off_settings():
+    assert preset("extended").back_off_to is None
+    assert apply_overrides(preset("extended"), ["back_off_to=0.8"]).back_off_to == 0.8
+    with pytest.raises(ConfigError, match="back_off_to needs the gain trials"):
+        preset("extended", gains=(), back_off_to=0.8)
+    with pytest.raises(ConfigError, match="back_off_to needs the gain trials"):
+        preset("faithful", back_off_to=0.8)
+    with pytest.raises(ConfigError, match=r"back_off_to=3\.0: expected a scale"):
+        preset("extended", back_off_to=3.0)
+
+
+def test_a_run_that_backs_off_is_used_and_evaluated_at_the_scale_it_settled_at(
+    monkeypatch, tmp_path, robot, tiny_reference
+):
+    from imitwalk import plots
+    from imitwalk.evaluate import load_gait
+    from imitwalk.learner import learn
+
+    ref, _ = tiny_reference
+    sets = [*TINY, "train_models=2", "gains=0,0.5,1", "back_off_to=0.3"]
+    cfg = apply_overrides(preset("extended"), sets)
+    calls: list = []  # the trials are faked: the kept gain falls at 0.4, not at 0.3
+    monkeypatch.setattr(tuning, "tune", _fake_tune({0.4: (2, 1, 3), 0.3: (1, 0, 0)}, calls))
+    summary = learn(ref, robot, cfg, tmp_path / "run")
+    assert summary["scales_passed"] == [0.3, 0.4]
+    assert [c[0] for c in calls] == [0.4, 0.3]
+    assert summary["scale_reached"] == 0.3 and summary["channel_gain"] == 0.5
+    assert summary["back_off"]["from"] == 0.4 and summary["gain_trials"]["scale"] == 0.3
+    lg = load_gait(tmp_path / "run")
+    assert lg.scale == 0.3 and lg.config.step.gain == 0.5
+    fig = plots.fig7_schedule(lg.gait, summary["scales_passed"], None, lg.scale)
+    title = "Motion pattern scaling: reached 0.3 of the schedule (passed 0.4, backed off)"
+    assert fig.axes[0].get_title() == title
+
+
+def test_the_report_names_the_back_off_and_the_trials_that_decided_it():
+    from imitwalk.media import gain
+
+    metrics = {
+        "channel_gain": 0.5,
+        "gain_trials": _trials((2, 0, 0), scale=0.9),
+        "back_off": {"from": 1.0, "scale": 0.9, "trials": [_trials((2, 0, 0), scale=0.9)]},
+    }
+    text = gain(metrics)
+    assert text.startswith("backed off from scale 1 to 0.9; channel gain 0.5")
+    assert "trials at scale 0.9 on 2 robots: 0: 2 fell, 0.5: 0 fell, 1: 0 fell" in text
+    kept_top = {**metrics, "back_off": {"from": 1.0, "scale": 1.0, "trials": []}}
+    assert "backed off" not in gain(kept_top)
