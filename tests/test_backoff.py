@@ -32,6 +32,11 @@ def _fake_tune(falls_by_scale: dict, calls: list):
     return tune
 
 
+def _strip(summary: dict) -> dict:
+    """A learning summary without its wall times (the one thing a rerun may change)."""
+    return {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
+
+
 def _state(top_falls: tuple[int, ...]) -> dict:
     passed = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
     return {"passed": passed, "gain": _trials(top_falls), "sim_seconds": 0.0, "wall_seconds": 0.0}
@@ -114,6 +119,16 @@ def test_a_run_that_backs_off_is_used_and_evaluated_at_the_scale_it_settled_at(
     assert summary["back_off"]["from"] == 0.4 and summary["gain_trials"]["scale"] == 0.3
     lg = load_gait(tmp_path / "run")
     assert lg.scale == 0.3 and lg.config.step.gain == 0.5
+
+    # interrupted in the back-off, a resume ends where the whole run did
+    def interrupt(text):
+        if text.startswith("back-off: the kept gain fell"):
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
+    resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
+    assert _strip(resumed) == _strip(summary)
     fig = plots.fig7_schedule(lg.gait, summary["scales_passed"], None, lg.scale)
     title = "Motion pattern scaling: reached 0.3 of the schedule (passed 0.4, backed off)"
     assert fig.axes[0].get_title() == title
