@@ -190,21 +190,21 @@ def learn(
         tuning.retry_with_offset(gait, robot, config, data, max(state["passed"]), state, progress)
         rd.write_json("checkpoint.json", state)
     run_cfg = config.with_offset(state.get("offset"))
-    top = max(state["passed"]) if state["passed"] else 0.0
+    reached = max(state["passed"]) if state["passed"] else 0.0  # lower after a back-off
     for key, values in (("gain", config.gains), ("cadence", config.cadences)):
         if values and config.steps and state["passed"] and key not in state:
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain
-            choice = tuning.tune(gait, robot, run_cfg, data, top, key, values, gain, progress)
+            choice = tuning.tune(gait, robot, run_cfg, data, reached, key, values, gain, progress)
             state[key] = choice.to_dict()
             state["sim_seconds"] += choice.sim_seconds
             state["wall_seconds"] += choice.wall_seconds
             rd.write_json("checkpoint.json", state)
         if key == "gain" and config.back_off_to is not None and "gain" in state:
-            top = tuning.back_off(gait, robot, config, data, state, progress)
+            reached = tuning.back_off(gait, robot, config, data, state, progress)
             rd.write_json("checkpoint.json", state)
     summary = {
         "variant": config.variant,
-        "scale_reached": top,
+        "scale_reached": reached,
         "scales_passed": state["passed"],
         "iterations": state["total_iterations"],
         "sim_seconds_used_for_learning": state["sim_seconds"],
