@@ -19,6 +19,15 @@ TINY = [
 ]
 
 
+def strip_wall(summary: dict) -> dict:
+    """A learning summary without its wall times (the one thing a rerun may change)."""
+    out = {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
+    for key in ("gain_trials", "cadence_trials"):
+        if out.get(key):
+            out[key] = {k: v for k, v in out[key].items() if k != "wall_seconds"}
+    return out
+
+
 @pytest.fixture(scope="session")
 def shared_mocap() -> Path:
     """Folder of the shared real mocap fixtures: ``$IMITWALK_SHARED_MOCAP``, else

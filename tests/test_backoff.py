@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from conftest import TINY
+from conftest import TINY, strip_wall
 from imitwalk import tuning
 from imitwalk.config import apply_overrides
 from imitwalk.errors import ConfigError
@@ -30,11 +30,6 @@ def _fake_tune(falls_by_scale: dict, calls: list):
         return GainChoice(t["gain"], tuple(t["seeds"]), t["table"], 60.0, 2.0, key)
 
     return tune
-
-
-def _strip(summary: dict) -> dict:
-    """A learning summary without its wall times (the one thing a rerun may change)."""
-    return {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
 
 
 def _state(top_falls: tuple[int, ...]) -> dict:
@@ -128,7 +123,7 @@ def test_a_run_that_backs_off_is_used_and_evaluated_at_the_scale_it_settled_at(
     with pytest.raises(KeyboardInterrupt):
         learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
     resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
-    assert _strip(resumed) == _strip(summary)
+    assert strip_wall(resumed) == strip_wall(summary)
     fig = plots.fig7_schedule(lg.gait, summary["scales_passed"], None, lg.scale)
     title = "Motion pattern scaling: reached 0.3 of the schedule (passed 0.4, backed off)"
     assert fig.axes[0].get_title() == title

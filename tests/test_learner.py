@@ -7,21 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from conftest import TINY
+from conftest import TINY, strip_wall
 from imitwalk.cli import main
 from imitwalk.config import apply_overrides
 from imitwalk.learnconfig import preset
 from imitwalk.learner import learn
 from imitwalk.runs import RunDir
-
-
-def _strip(m: dict) -> dict:
-    """A summary without its wall times (the one thing a rerun may change)."""
-    out = {k: v for k, v in m.items() if k != "wall_seconds_for_learning"}
-    for key in ("gain_trials", "cadence_trials"):
-        if out.get(key):
-            out[key] = {k: v for k, v in out[key].items() if k != "wall_seconds"}
-    return out
 
 
 @pytest.mark.parametrize("variant", ["faithful", "extended"])
@@ -30,7 +21,7 @@ def test_same_seed_same_result(tmp_path, robot, tiny_reference, variant):
     cfg = apply_overrides(preset(variant), [*TINY, "train_models=2", "cadences=1,1.12"])
     a = learn(ref, robot, cfg, tmp_path / "a")
     b = learn(ref, robot, cfg, tmp_path / "b")
-    assert _strip(a) == _strip(b)
+    assert strip_wall(a) == strip_wall(b)
     if variant == "extended":  # the gain trials ran on their own robots, every candidate
         from imitwalk.perturb import trial_seeds
 
@@ -77,7 +68,7 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
     assert rd.read_json("checkpoint.json")["total_iterations"] == 2
     assert not rd.exists("metrics.json")
     resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
-    assert _strip(resumed) == _strip(whole)
+    assert strip_wall(resumed) == strip_wall(whole)
     log_w = [e["falls"] for e in RunDir(tmp_path / "whole").read_log()]
     assert [e["falls"] for e in rd.read_log()] == log_w
     # fresh training robots every iteration, the same ones after a resume
@@ -103,7 +94,7 @@ def test_a_run_interrupted_in_its_trials_resumes_to_the_same_end(
         learn(ref, robot, cfg, tmp_path / "cut", progress=interrupt)
     assert key not in RunDir(tmp_path / "cut").read_json("checkpoint.json")
     resumed = learn(ref, robot, cfg, tmp_path / "cut", resume=True)
-    assert _strip(resumed) == _strip(whole)
+    assert strip_wall(resumed) == strip_wall(whole)
 
 
 def test_training_robot_draws_never_overlap_or_meet_an_evaluation_robot():

@@ -196,8 +196,7 @@ def learn(
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain
             choice = tuning.tune(gait, robot, run_cfg, data, reached, key, values, gain, progress)
             state[key] = choice.to_dict()
-            state["sim_seconds"] += choice.sim_seconds
-            state["wall_seconds"] += choice.wall_seconds
+            tuning.spend(state, choice)
             rd.write_json("checkpoint.json", state)
         if key == "gain" and config.back_off_to is not None and "gain" in state:
             reached = tuning.back_off(gait, robot, config, data, state, progress)

@@ -190,8 +190,7 @@ def _sections(
 ) -> str:
     gait, scale, log, m = lg.gait, rp.scale, rd.read_log(), lg.metrics
     passed = [float(p) for p in m.get("scales_passed", [])]
-    reached = float(m.get("scale_reached") or (max(passed) if passed else 0.0))
-    at_final = bool(passed) and abs(reached - scale) < 1e-9
+    at_final = bool(passed) and abs(lg.scale - scale) < 1e-9  # lg.scale: the scale reached
     evr = gait.subspace.explained_variance_ratio_
     if rd.exists("evaluation.json"):
         evaluation = _metrics_table(rd.read_json("evaluation.json"))
@@ -209,7 +208,7 @@ def _sections(
         rp.before.control_dt,
         fall_times=(rp.before.fall_time, rp.after.fall_time),
     )
-    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None, reached)
+    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None, lg.scale)
     sections = [
         (
             "Before and after",

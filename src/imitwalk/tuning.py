@@ -24,7 +24,7 @@ from imitwalk.retarget.cadence import with_cadence
 from imitwalk.stepconfig import STEP_CHANNELS
 from imitwalk.trust import LABELS, GainChoice, tune_gain
 
-__all__ = ["back_off", "kept_falls", "retry_with_offset", "tune"]
+__all__ = ["back_off", "kept_falls", "retry_with_offset", "spend", "tune"]
 
 
 def tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progress) -> GainChoice:
@@ -55,7 +55,8 @@ def tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progr
     return replace(choice, wall_seconds=time.perf_counter() - t0)
 
 
-def _spend(state: dict, choice: GainChoice) -> None:
+def spend(state: dict, choice: GainChoice) -> None:
+    """Add a round of trials' simulated and wall time [s] to the learner's ``state``."""
     state["sim_seconds"] += choice.sim_seconds
     state["wall_seconds"] += choice.wall_seconds
 
@@ -72,7 +73,7 @@ def retry_with_offset(gait, robot, config: LearnConfig, data, scale, state, prog
     gain = run_cfg.step.gain
     choice = tune(gait, robot, run_cfg, data, scale, "offset", values, gain, progress)
     state.setdefault("offset_trials", []).append({"scale": scale, **choice.to_dict()})
-    _spend(state, choice)
+    spend(state, choice)
     if choice.gain == now:
         return False
     state["offset"], state["failures"] = choice.gain, 0
@@ -103,14 +104,14 @@ def back_off(gait, robot, config: LearnConfig, data, state, progress) -> float:
     floor = config.back_off_to - 1e-9
     below = sorted((s for s in state["passed"] if floor <= s < top), reverse=True)
     scale, best, rounds = top, state["gain"], []
+    run_cfg = config.with_offset(state.get("offset"))
     for lower in below:
         if kept_falls(best) == 0:
             break
         if progress:
             progress(f"back-off: the kept gain fell at scale {scale:g}; trials at {lower:g}")
-        run_cfg = config.with_offset(state.get("offset"))
         choice = tune(gait, robot, run_cfg, data, lower, "gain", config.gains, None, progress)
-        _spend(state, choice)
+        spend(state, choice)
         trials = {"scale": lower, **choice.to_dict()}
         rounds.append(trials)
         if kept_falls(trials) >= kept_falls(best):
