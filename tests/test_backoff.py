@@ -1,7 +1,10 @@
 """The back-off (``LearnConfig.back_off_to``): give back scale when the gain trials at the
-top scale still fall (:func:`imitwalk.tuning.back_off`)."""
+top scale still fall (:func:`imitwalk.tuning.back_off`), or when its consolidation does
+(``back_off_when``, :func:`imitwalk.tuning.give_back_scale`)."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import pytest
 
@@ -10,6 +13,7 @@ from imitwalk import tuning
 from imitwalk.config import apply_overrides
 from imitwalk.errors import ConfigError
 from imitwalk.learnconfig import preset
+from imitwalk.runs import RunDir
 from imitwalk.trust import GainChoice
 
 GAINS = (0.0, 0.5, 1.0)
@@ -81,7 +85,7 @@ def test_no_back_off_when_the_top_scale_walks_on_every_trial_robot(monkeypatch):
     state = _state((1, 0, 2))
     cfg = preset("extended", back_off_to=0.5)
     assert tuning.back_off(None, None, cfg, {}, state, None) == 0.9
-    assert state["back_off"] == {"from": 0.9, "scale": 0.9, "trials": []}
+    assert state["back_off"] == {"from": 0.9, "scale": 0.9, "trials": [], "consolidation": []}
 
 
 def test_back_off_settings():
@@ -142,3 +146,113 @@ def test_the_report_names_the_back_off_and_the_trials_that_decided_it():
     assert "trials at scale 0.9 on 2 robots: 0: 2 fell, 0.5: 0 fell, 1: 0 fell" in text
     kept_top = {**metrics, "back_off": {"from": 1.0, "scale": 1.0, "trials": []}}
     assert "backed off" not in gain(kept_top)
+
+
+def _consolidation_log(falls_by_scale: dict, consolidate: int = 2) -> list[dict]:
+    """The last ``consolidate`` log entries of a consolidation at each scale, in order."""
+    return [
+        {"scale": s, "falls": f, "robots": 6, "consolidation": True}
+        for s, f in falls_by_scale.items()
+        for _ in range(consolidate)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("when", "floor", "falls", "next_scale"),
+    [
+        (("consolidation", "trials"), 0.8, 1, 0.8),  # it fell: consolidate one scale down
+        (("consolidation",), 0.8, 0, None),  # it walked: settle here
+        (("trials",), 0.8, 1, None),  # the trials only (the default): settle here
+        (("consolidation",), 0.9, 1, None),  # never below back_off_to
+    ],
+)
+def test_a_consolidation_that_falls_gives_its_scale_back(when, floor, falls, next_scale):
+    cfg = preset("extended", back_off_to=floor, back_off_when=when)
+    state = _state((1, 0, 0))
+    log = [{"scale": 0.9, "falls": 3, "robots": 6}, *_consolidation_log({0.9: falls})]
+    assert tuning.give_back_scale(cfg, state, log) == next_scale
+    assert state["settled"] == 0.9
+    assert state["consolidated"] == [{"scale": 0.9, "falls": 2 * falls, "robots": 12}]
+
+
+def test_without_back_off_a_consolidation_is_recorded_and_kept():
+    state = _state((1, 0, 0))
+    assert tuning.give_back_scale(preset("extended"), state, _consolidation_log({0.9: 2})) is None
+    assert state["settled"] == 0.9
+
+
+def test_the_trials_start_from_the_scale_the_consolidation_settled_at(monkeypatch):
+    calls: list = []
+    monkeypatch.setattr(tuning, "tune", _fake_tune({0.7: (3, 0, 2)}, calls))
+    cfg = preset("extended", back_off_to=0.7, back_off_when=("consolidation", "trials"))
+    state = {**_state((2, 1, 1)), "settled": 0.8}  # consolidated down from 0.9 to 0.8
+    state["consolidated"] = [{"scale": 0.9, "falls": 1, "robots": 12}]
+    state["consolidated"].append({"scale": 0.8, "falls": 0, "robots": 12})
+    assert tuning.back_off(None, None, cfg, {}, state, None) == 0.7
+    assert [c[0] for c in calls] == [0.7]
+    assert state["back_off"]["from"] == 0.9 and state["back_off"]["consolidation"][0]["falls"] == 1
+    # with the consolidation alone as evidence, no trials run below the scale it settled at
+    calls.clear()
+    state = {**_state((2, 1, 1)), "settled": 0.8}
+    cfg = replace(cfg, back_off_when=("consolidation",))
+    assert tuning.back_off(None, None, cfg, {}, state, None) == 0.8
+    assert calls == []
+
+
+def test_back_off_when_settings():
+    assert preset("extended").back_off_when == ("trials",)
+    sets = ["back_off_to=0.8", "back_off_when=consolidation,trials"]
+    cfg = apply_overrides(preset("extended"), sets)
+    assert cfg.back_off_when == ("consolidation", "trials")
+    with pytest.raises(ConfigError, match=r"unknown back_off_when 'falls'; valid: consolidation"):
+        apply_overrides(preset("extended"), ["back_off_when=falls"])
+    with pytest.raises(ConfigError, match="back_off_when needs back_off_to"):
+        preset("extended", back_off_when=("consolidation",))
+    with pytest.raises(ConfigError, match="back_off_when is empty"):
+        preset("extended", back_off_to=0.8, back_off_when=())
+    with pytest.raises(ConfigError, match=r"needs schedule\.consolidate"):
+        apply_overrides(cfg, ["schedule.consolidate=0"])
+
+
+def test_a_run_whose_consolidation_falls_settles_one_scale_down(
+    monkeypatch, tmp_path, robot, tiny_reference
+):
+    from imitwalk import learner
+    from imitwalk.evaluate import load_gait
+
+    ref, _ = tiny_reference
+    sets = [*TINY, "train_models=2", "gains=0,0.5,1", "back_off_to=0.3"]
+    cfg = apply_overrides(preset("extended"), [*sets, "back_off_when=consolidation,trials"])
+    calls: list = []
+    monkeypatch.setattr(tuning, "tune", _fake_tune({0.3: (1, 0, 0)}, calls))
+    at_top, log_entry = [], learner._iteration_log
+
+    def consolidation_falls_at_the_top(scale, it, results, reports, t0):
+        entry = log_entry(scale, it, results, reports, t0)
+        at_top.append(scale) if scale == 0.4 else None
+        if len(at_top) > 3 and scale == 0.4:  # the schedule passed 0.4 in three iterations
+            entry["falls"], entry["fell"] = 1, [True, *entry["fell"][1:]]
+        return entry
+
+    monkeypatch.setattr(learner, "_iteration_log", consolidation_falls_at_the_top)
+    summary = learner.learn(ref, robot, cfg, tmp_path / "run")
+    assert summary["scales_passed"] == [0.3, 0.4]
+    assert summary["scale_reached"] == 0.3 and [c[0] for c in calls] == [0.3]
+    back = summary["back_off"]
+    assert back["from"] == 0.4 and back["scale"] == 0.3 and back["trials"] == []
+    assert [(c["scale"], c["falls"]) for c in back["consolidation"]] == [(0.4, 2), (0.3, 0)]
+    log = load_gait(tmp_path / "run")
+    assert log.scale == 0.3
+    entries = [e for e in RunDir(tmp_path / "run").read_log() if e["consolidation"]]
+    assert [e["scale"] for e in entries] == [0.4, 0.4, 0.3, 0.3]
+
+
+def test_the_report_says_why_the_consolidation_gave_scale_back():
+    from imitwalk.media import gain
+
+    back = {"from": 0.9, "scale": 0.8, "trials": []}
+    back["consolidation"] = [{"scale": 0.9, "falls": 2, "robots": 12}]
+    metrics = {"channel_gain": 0.5, "gain_trials": _trials((2, 0, 0), 0.8), "back_off": back}
+    assert gain(metrics).startswith(
+        "backed off from scale 0.9 to 0.8 (its consolidation fell on 2 of 12 at 0.9); "
+    )

@@ -23,7 +23,11 @@ from imitwalk.perturb import FRICTION_RANGE
 from imitwalk.simtypes import ENGINES
 from imitwalk.stepconfig import STEP_CHANNELS, StepConfig
 
-__all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
+__all__ = ["BACK_OFF_EVIDENCE", "VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
+
+
+#: What the back-off (``LearnConfig.back_off_when``) may act on.
+BACK_OFF_EVIDENCE = ("consolidation", "trials")
 
 
 @dataclass(frozen=True)
@@ -120,6 +124,12 @@ class LearnConfig:
             robots, the walk settles there (and the search goes on lower while it still
             falls), never below this scale. The scale settled at is ``scale_reached``
             (:func:`imitwalk.tuning.back_off`). Needs ``gains``.
+        back_off_when: the evidence the back-off acts on (:data:`BACK_OFF_EVIDENCE`):
+            ``"trials"``, the gain trials above; ``"consolidation"``, the consolidation
+            iterations at the scale reached: if they fall on any training robot, the
+            scale is given back and the consolidation runs again one passed scale lower
+            (never below ``back_off_to``; needs ``schedule.consolidate``), before the gain
+            trials (:func:`imitwalk.tuning.give_back_scale`). Default: the trials only.
         seed: random seed; workers: parallel processes (``None``: one per core).
         engine: the physics engine the robot learns on (:data:`imitwalk.simtypes.ENGINES`;
             ``bullet`` is about ten times slower than MuJoCo).
@@ -142,6 +152,7 @@ class LearnConfig:
     gain_seconds: float = 24.0
     stratify_trials: bool = False
     back_off_to: float | None = None
+    back_off_when: tuple[str, ...] = ("trials",)
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"
@@ -175,6 +186,15 @@ class LearnConfig:
             raise ConfigError("back_off_to needs the gain trials: set gains (and steps=true)")
         if self.back_off_to is not None and not 0.0 < self.back_off_to <= 2.0:
             raise ConfigError(f"back_off_to={self.back_off_to}: expected a scale in 0..2")
+        for what in self.back_off_when:
+            if what not in BACK_OFF_EVIDENCE:
+                raise unknown_name("back_off_when", what, BACK_OFF_EVIDENCE, ConfigError)
+        if self.back_off_to is None and tuple(self.back_off_when) != ("trials",):
+            raise ConfigError("back_off_when needs back_off_to: the lowest scale to give back to")
+        if self.back_off_to is not None and not self.back_off_when:
+            raise ConfigError(f"back_off_when is empty: list one or more of {BACK_OFF_EVIDENCE}")
+        if "consolidation" in self.back_off_when and self.schedule.consolidate < 1:
+            raise ConfigError("back_off_when=consolidation needs schedule.consolidate >= 1")
         if (self.gains or self.cadences or self.offsets) and self.gain_robots < 1:
             raise ConfigError(f"gain_robots={self.gain_robots}: expected at least 1")
 

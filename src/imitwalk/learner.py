@@ -17,7 +17,9 @@ are checkpointed too. After every
 iteration the run folder is checkpointed atomically, so ``resume`` continues an
 interrupted run and ends where an uninterrupted one would (same seed, same result).
 With ``back_off_to``, a run whose gain trials still fall at the top scale gives back
-scale where the same trials measure fewer falls (:func:`imitwalk.tuning.back_off`); the
+scale where the same trials measure fewer falls (:func:`imitwalk.tuning.back_off`), and
+with ``back_off_when`` including ``"consolidation"`` one whose consolidation falls
+consolidates one scale lower first (:func:`imitwalk.tuning.give_back_scale`); the
 trials themselves run in :mod:`imitwalk.tuning`.
 """
 
@@ -154,6 +156,12 @@ def learn(
         if polishing:
             state["consolidate_left"] -= 1
             state["done"] = state["consolidate_left"] <= 0
+            lower = tuning.give_back_scale(config, state, log) if state["done"] else None
+            if lower is not None:  # its consolidation fell: consolidate one scale down
+                state["done"], state["consolidate_left"] = False, sch.consolidate
+                state["scale_index"] = scales.index(lower)
+                if progress:
+                    progress(f"back-off: the consolidation fell at {scale:g}; on to {lower:g}")
         elif fell:
             state["failures"] += 1
             state["clean"] = 0
@@ -186,11 +194,12 @@ def learn(
         rd.write_json("checkpoint.json", state)
         if progress:
             progress(_progress_line(entry))
+    # the top scale passed, or the one the consolidation settled at; lower after a back-off
+    reached = state.get("settled", max(state["passed"])) if state["passed"] else 0.0
     if config.offsets and state["passed"]:  # and at the scale reached (once per scale)
-        tuning.retry_with_offset(gait, robot, config, data, max(state["passed"]), state, progress)
+        tuning.retry_with_offset(gait, robot, config, data, reached, state, progress)
         rd.write_json("checkpoint.json", state)
     run_cfg = config.with_offset(state.get("offset"))
-    reached = max(state["passed"]) if state["passed"] else 0.0  # lower after a back-off
     for key, values in (("gain", config.gains), ("cadence", config.cadences)):
         if values and config.steps and state["passed"] and key not in state:
             gain = state["gain"]["gain"] if "gain" in state else config.step.gain

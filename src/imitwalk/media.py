@@ -75,7 +75,10 @@ def gain(metrics: dict) -> str:
     parts = []
     back = metrics.get("back_off") or {}
     if back and back["scale"] != back["from"]:
-        parts.append(f"backed off from scale {back['from']:g} to {back['scale']:g}")
+        fell = [c for c in back.get("consolidation", []) if c["falls"]]
+        why = ", ".join(f"{c['falls']} of {c['robots']} at {c['scale']:g}" for c in fell)
+        why = f" (its consolidation fell on {why})" if why else ""
+        parts.append(f"backed off from scale {back['from']:g} to {back['scale']:g}{why}")
     for key, label in LABELS.items():
         if key == "offset":  # one round of trials per scale where they ran, if any
             kept = metrics.get("channel_offset") or {}

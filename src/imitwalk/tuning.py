@@ -24,7 +24,7 @@ from imitwalk.retarget.cadence import with_cadence
 from imitwalk.stepconfig import STEP_CHANNELS
 from imitwalk.trust import LABELS, GainChoice, tune_gain
 
-__all__ = ["back_off", "kept_falls", "retry_with_offset", "spend", "tune"]
+__all__ = ["back_off", "give_back_scale", "kept_falls", "retry_with_offset", "spend", "tune"]
 
 
 def tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progress) -> GainChoice:
@@ -85,24 +85,55 @@ def kept_falls(trials: dict, key: str = "gain") -> int:
     return next(r["falls"] for r in trials["table"] if r[key] == trials[key])
 
 
+def give_back_scale(config: LearnConfig, state: dict, log: list[dict]) -> float | None:
+    """The consolidation iterations at a scale have ended: the scale to consolidate at
+    next, or ``None`` to settle at this one.
+
+    The consolidation runs the learned controller without exploration on training robots
+    (fresh ones with ``fresh_robots``) at the scale reached: a further confirmation of
+    that scale. With ``back_off_to`` set and ``"consolidation"`` in ``back_off_when``, a
+    fall in it on any robot gives the scale back: the consolidation runs again at the next
+    passed scale down, not below ``back_off_to``. Every consolidation is recorded in
+    ``state["consolidated"]`` (``scale``, ``falls``, ``robots``), and the scale it ended
+    at in ``state["settled"]``.
+    """
+    done = log[-config.schedule.consolidate :]
+    scale = done[-1]["scale"]
+    falls = sum(e["falls"] for e in done)
+    state.setdefault("consolidated", []).append(
+        {"scale": scale, "falls": falls, "robots": sum(e["robots"] for e in done)}
+    )
+    state["settled"] = scale
+    if config.back_off_to is None or "consolidation" not in config.back_off_when or not falls:
+        return None
+    below = [s for s in state["passed"] if config.back_off_to - 1e-9 <= s < scale - 1e-9]
+    return max(below) if below else None
+
+
 def back_off(gait, robot, config: LearnConfig, data, state, progress) -> float:
     """Give back scale while the gain trials at the scale reached still fall (``back_off_to``).
 
-    ``state["gain"]`` holds the gain trials at the top scale the schedule passed. While
-    the gain kept there still falls on some trial robot, the same gain trials run one
-    passed scale lower (not below ``config.back_off_to``); if the best gain there falls
-    on fewer trial robots, the walk settles at that scale with that gain and the search
-    goes on one scale lower. ``state["back_off"]`` records the top, the scale settled at
-    and every round of trials; ``state["gain"]`` becomes the settled scale's trials.
+    ``state["gain"]`` holds the gain trials at the scale reached: the top scale the
+    schedule passed, or the one its consolidation settled at (:func:`give_back_scale`).
+    With ``"trials"`` in ``back_off_when``, while the gain kept there still falls on some
+    trial robot, the same gain trials run one passed scale lower (not below
+    ``config.back_off_to``); if the best gain there falls on fewer trial robots, the walk
+    settles at that scale with that gain and the search goes on one scale lower.
+    ``state["back_off"]`` records the top passed (``from``), the scale settled at, every
+    round of trials and every consolidation; ``state["gain"]`` becomes the settled
+    scale's trials.
 
     Returns:
-        the scale the walk settles at (the top if nothing measured better below it).
+        the scale the walk settles at (the scale reached if nothing measured better
+        below it).
     """
-    top = max(state["passed"])
     if "back_off" in state:
         return state["back_off"]["scale"]
+    top = state.get("settled", max(state["passed"]))
     floor = config.back_off_to - 1e-9
     below = sorted((s for s in state["passed"] if floor <= s < top), reverse=True)
+    if "trials" not in config.back_off_when:
+        below = []
     scale, best, rounds = top, state["gain"], []
     run_cfg = config.with_offset(state.get("offset"))
     for lower in below:
@@ -117,8 +148,14 @@ def back_off(gait, robot, config: LearnConfig, data, state, progress) -> float:
         if kept_falls(trials) >= kept_falls(best):
             break
         scale, best = lower, trials
-    state["back_off"] = {"from": top, "scale": scale, "trials": rounds}
+    start = max(state["passed"])
+    state["back_off"] = {
+        "from": start,
+        "scale": scale,
+        "trials": rounds,
+        "consolidation": state.get("consolidated", []),
+    }
     state["gain"] = best
-    if progress and scale != top:
-        progress(f"back-off: settled at scale {scale:g} (from {top:g}), gain {best['gain']:g}")
+    if progress and scale != start:
+        progress(f"back-off: settled at scale {scale:g} (from {start:g}), gain {best['gain']:g}")
     return scale
