@@ -194,8 +194,7 @@ def learn(
         rd.write_json("checkpoint.json", state)
         if progress:
             progress(_progress_line(entry))
-    # the top scale passed, or the one the consolidation settled at; lower after a back-off
-    reached = state.get("settled", max(state["passed"])) if state["passed"] else 0.0
+    reached = tuning.settled_scale(state)  # lower after a back-off in the trials
     if config.offsets and state["passed"]:  # and at the scale reached (once per scale)
         tuning.retry_with_offset(gait, robot, config, data, reached, state, progress)
         rd.write_json("checkpoint.json", state)

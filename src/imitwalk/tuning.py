@@ -24,7 +24,15 @@ from imitwalk.retarget.cadence import with_cadence
 from imitwalk.stepconfig import STEP_CHANNELS
 from imitwalk.trust import LABELS, GainChoice, tune_gain
 
-__all__ = ["back_off", "give_back_scale", "kept_falls", "retry_with_offset", "spend", "tune"]
+__all__ = [
+    "back_off",
+    "give_back_scale",
+    "kept_falls",
+    "retry_with_offset",
+    "settled_scale",
+    "spend",
+    "tune",
+]
 
 
 def tune(gait, robot, config: LearnConfig, data, scale, key, values, gain, progress) -> GainChoice:
@@ -85,6 +93,18 @@ def kept_falls(trials: dict, key: str = "gain") -> int:
     return next(r["falls"] for r in trials["table"] if r[key] == trials[key])
 
 
+def settled_scale(state: dict) -> float:
+    """The scale reached before the gain trials: the top scale the schedule passed, or the
+    one its consolidation settled at (:func:`give_back_scale`); 0 if none passed."""
+    return state.get("settled", max(state["passed"])) if state["passed"] else 0.0
+
+
+def _passed_below(config: LearnConfig, state: dict, scale: float) -> list[float]:
+    """The passed scales below ``scale`` and not below ``back_off_to``, highest first."""
+    floor = config.back_off_to - 1e-9
+    return sorted((s for s in state["passed"] if floor <= s < scale - 1e-9), reverse=True)
+
+
 def give_back_scale(config: LearnConfig, state: dict, log: list[dict]) -> float | None:
     """The consolidation iterations at a scale have ended: the scale to consolidate at
     next, or ``None`` to settle at this one.
@@ -106,8 +126,8 @@ def give_back_scale(config: LearnConfig, state: dict, log: list[dict]) -> float 
     state["settled"] = scale
     if config.back_off_to is None or "consolidation" not in config.back_off_when or not falls:
         return None
-    below = [s for s in state["passed"] if config.back_off_to - 1e-9 <= s < scale - 1e-9]
-    return max(below) if below else None
+    below = _passed_below(config, state, scale)
+    return below[0] if below else None
 
 
 def back_off(gait, robot, config: LearnConfig, data, state, progress) -> float:
@@ -129,11 +149,8 @@ def back_off(gait, robot, config: LearnConfig, data, state, progress) -> float:
     """
     if "back_off" in state:
         return state["back_off"]["scale"]
-    top = state.get("settled", max(state["passed"]))
-    floor = config.back_off_to - 1e-9
-    below = sorted((s for s in state["passed"] if floor <= s < top), reverse=True)
-    if "trials" not in config.back_off_when:
-        below = []
+    top = settled_scale(state)
+    below = _passed_below(config, state, top) if "trials" in config.back_off_when else []
     scale, best, rounds = top, state["gain"], []
     run_cfg = config.with_offset(state.get("offset"))
     for lower in below:
