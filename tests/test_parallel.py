@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 from imitwalk.errors import ConfigError
@@ -15,6 +17,28 @@ def _square(x: int) -> int:
 def test_process_pool_keeps_job_order():
     assert run_parallel(_square, list(range(7)), workers=2) == [x * x for x in range(7)]
     assert run_parallel(_square, list(range(3)), workers=1) == [0, 1, 4]
+
+
+def _mark(job: tuple) -> int:
+    """Square ``x`` after a short wait, and leave a file saying that job ``x`` ran."""
+    folder, x = job
+    time.sleep(0.05)
+    (folder / f"{x}.ran").touch()
+    return x * x
+
+
+def test_a_map_with_stop_returns_the_shortest_prefix_it_accepts_and_skips_the_rest(tmp_path):
+    def stop(squares):
+        return sum(squares) > 10  # 0 + 1 + 4 + 9
+
+    for workers in (1, 2):
+        folder = tmp_path / str(workers)
+        folder.mkdir()
+        jobs = [(folder, x) for x in range(40)]
+        assert run_parallel(_mark, jobs, workers=workers, stop=stop) == [0, 1, 4, 9]
+        ran = len(list(folder.iterdir()))
+        assert 4 <= ran < 40  # the jobs not yet started when it stopped never ran
+    assert run_parallel(_square, [0, 1, 2], workers=2, stop=stop) == [0, 1, 4]  # never held
 
 
 def test_unknown_executor_lists_the_valid_ones(monkeypatch):
@@ -36,6 +60,8 @@ def test_ray_executor_runs_a_playback_sweep(monkeypatch, tiny_reference, robot):
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         remote = play_reference(ref, robot, 0.3, 2.0, [0, 1])
+        first = play_reference(ref, robot, 0.3, 2.0, [0, 1], stop=lambda runs: True)
     finally:
         ray.shutdown()
     assert [r.metrics for r in remote] == [r.metrics for r in local]
+    assert [r.metrics for r in first] == [local[0].metrics]

@@ -28,30 +28,55 @@ def _falls(p: dict) -> int:
     return round(abs(p["lean"] - 0.003) / 0.0015) + round(abs(p["ds"] - 0.14) / 0.02)
 
 
+def _stops(play):
+    """``play`` with the real playback's ``stop``: the shortest prefix of its runs, in
+    seed order, that ``stop`` accepts."""
+
+    def with_stop(*args, stop=None, **kw):
+        runs = play(*args, **kw)
+        for i in range(len(runs)):
+            if stop is not None and stop(runs[: i + 1]):
+                return runs[: i + 1]
+        return runs
+
+    return with_stop
+
+
+played: list[tuple] = []  # (scale, seconds, seeds, disturbance) of each stubbed playback
+
+
+def _play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
+    """A stubbed playback: the first ``_falls(ref)`` robots fall, halfway through."""
+    played.append((scale, seconds, tuple(seeds), disturbance))
+    n = _falls(ref)
+    return [
+        SimpleNamespace(metrics=_Metrics(i < n, seconds / 2 if i < n else seconds, 1.0, 0.0))
+        for i in range(len(seeds))
+    ]
+
+
 @pytest.fixture
 def stubbed(monkeypatch):
     """No IK, no physics: a 'reference' is its parameters, and its falls are _falls."""
-    played = []
+    played.clear()
 
     def build(template, robot, params, scales, dt, ik=None, command=None):
         return SimpleNamespace(reference=params.to_dict())
 
-    def play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
-        played.append((scale, seconds, tuple(seeds), disturbance))
-        n = _falls(ref)
-        return [
-            SimpleNamespace(metrics=_Metrics(i < n, seconds / 2 if i < n else seconds, 1.0, 0.0))
-            for i in range(len(seeds))
-        ]
-
     monkeypatch.setattr(refine_mod, "WalkIK", lambda robot: None)
     monkeypatch.setattr(refine_mod, "build_walkable", build)
-    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_play))
     return played
 
 
 def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_once_nothing_falls(stubbed):
-    cfg = SearchConfig(scales=(0.5, 1.0), refine_rounds=5, refine_models=10, refine_seconds=4.0)
+    cfg = SearchConfig(
+        scales=(0.5, 1.0),
+        refine_rounds=5,
+        refine_models=10,
+        refine_seconds=4.0,
+        refine_early_stop=False,  # every robot of every trial played (the next test: not)
+    )
     start = GaitParams(lean=0.0, ds=0.1, lift=BOUNDS["lift"][0])
     seen = []
     params, rep = refine_params(None, None, start, cfg, progress=lambda *a: seen.append(a))
@@ -75,6 +100,61 @@ def test_refinement_keeps_the_first_nudge_that_falls_less_and_stops_once_nothing
     assert [a[2].kept for a in seen] == [t["kept"] for t in rep["trials"]]
 
 
+def _with_sway(play, sway: float):
+    """``play`` on a landscape where any nudge of the sway away from ``sway`` falls more."""
+
+    def worse(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
+        runs = play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance)
+        n = _falls(ref) + 3 * round(abs(ref["sway"] - sway) / STEPS["sway"])
+        return [
+            SimpleNamespace(metrics=replace(r.metrics, fell=i < n, seconds=seconds / (1 + (i < n))))
+            for i, r in enumerate(runs)
+        ]
+
+    return worse
+
+
+def test_early_stop_keeps_the_same_sets_and_plays_fewer_robots(stubbed, monkeypatch):
+    start = GaitParams(lean=0.0, ds=0.1, lift=BOUNDS["lift"][0])
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_with_sway(_play, start.sway)))
+    cfg = SearchConfig(refine_rounds=5, refine_models=10, refine_seconds=4.0)
+    full_params, full = refine_params(None, None, start, replace(cfg, refine_early_stop=False))
+    stubbed.clear()
+    params, rep = refine_params(None, None, start, cfg)
+    assert cfg.refine_early_stop and rep["early_stop"]  # on by default
+    # the same nudges, kept or not, in the same order: the same parameters
+    assert params == full_params and rep["falls"] == full["falls"]
+    assert [(t["changed"], t["kept"]) for t in rep["trials"]] == [
+        (t["changed"], t["kept"]) for t in full["trials"]
+    ]
+    stopped = 0
+    best = rep["trials"][0]
+    for t, f in zip(rep["trials"], full["trials"], strict=True):
+        if t["complete"]:
+            assert t == f  # a trial played to the end counts as before, to the bit
+        else:  # stopped once it fell more often than the set to beat: a lower bound
+            assert not t["kept"] and best["falls"] < t["falls"] <= f["falls"]
+            assert t["robots"] < f["robots"]
+            stopped += not t["repeat"]
+        if t["kept"]:
+            best = t
+    assert stopped == rep["stopped_early"] > 0
+    played = sum(t["robots"] for t in rep["trials"] if not t["repeat"])
+    assert rep["sim_seconds"] == played * 4.0 < full["sim_seconds"]
+    assert stubbed[0][0] == 1.0  # the longest stride, where most robots fall, is played first
+
+
+def test_early_stop_in_the_per_scale_refinement(stubbed, monkeypatch):
+    start = GaitParams(lean=0.0, ds=0.1)
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_with_sway(_play, start.sway)))
+    cfg = SearchConfig(refine_rounds=3, refine_scales=(1.0, 0.8), refine_models=5)
+    full_own, full = refine_per_scale(None, None, start, replace(cfg, refine_early_stop=False))
+    own, rep = refine_per_scale(None, None, start, cfg)
+    assert own == full_own and rep["falls"] == full["falls"]
+    assert rep["stopped_early"] > 0 and rep["sim_seconds"] < full["sim_seconds"]
+    assert all(t["robots"] <= 5 and (t["complete"] or not t["kept"]) for t in rep["trials"])
+
+
 def test_a_nudge_that_costs_progress_is_not_kept(stubbed, monkeypatch):
     def play(ref, robot, scale, seconds, seeds, base, workers, engine, disturbance):
         prog = 0.5 if ref["lean"] > 0.001 else 1.0  # more lean: fewer falls, but shuffles
@@ -83,7 +163,7 @@ def test_a_nudge_that_costs_progress_is_not_kept(stubbed, monkeypatch):
             SimpleNamespace(metrics=_Metrics(i < n, seconds, prog, 0.0)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
     cfg = SearchConfig(refine_rounds=2, refine_models=6, refine_seconds=4.0)
     params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
     assert params.lean == 0.0 and rep["falls"] == rep["start_falls"] == 2 * 3
@@ -99,7 +179,7 @@ def test_with_a_yaw_slack_a_nudge_that_turns_the_walk_is_not_kept(stubbed, monke
             SimpleNamespace(metrics=_Metrics(i < n, seconds, 1.0, yaw)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", play)
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
     cfg = SearchConfig(refine_rounds=3, refine_models=6, refine_seconds=4.0)
     params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
     assert params.lean == pytest.approx(0.003) and rep["falls"] == 0  # heading not guarded
@@ -127,8 +207,10 @@ def test_per_scale_refinement_finds_each_scale_its_own_set(stubbed, monkeypatch)
             SimpleNamespace(metrics=_Metrics(i < n, seconds, 1.0, 0.0)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", play)
-    cfg = SearchConfig(refine_rounds=4, refine_scales=(1.0, 0.8), refine_models=5)
+    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
+    cfg = SearchConfig(
+        refine_rounds=4, refine_scales=(1.0, 0.8), refine_models=5, refine_early_stop=False
+    )
     start = GaitParams(lean=0.0, ds=0.12)
     seen = []
     own, rep = refine_per_scale(None, None, start, cfg, progress=lambda *a: seen.append(a))

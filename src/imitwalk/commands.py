@@ -147,6 +147,8 @@ def refine_report(done: int, total: int, trial) -> None:
     """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
     what = (trial.changed or "searched") + ("" if trial.at is None else f" at {trial.at:g}")
     mark = " (kept)" if trial.changed and trial.kept else ""
+    if not trial.complete:
+        mark = " (stopped: falls more than the set to beat)"
     progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
 
 

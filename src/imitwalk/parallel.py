@@ -6,6 +6,10 @@ with ``IMITWALK_EXECUTOR=ray`` (and ``pip install 'imitwalk[ray]'``) they become
 tasks, so a sweep scales out to whatever cluster ``ray.init`` connects to
 (``RAY_ADDRESS``, or a local one). Results come back in job order and do not depend on
 the executor or the number of workers.
+
+With ``stop``, a map can end early: results are taken in job order, and once ``stop``
+holds for those taken so far, the jobs not yet started are cancelled and that prefix is
+returned. Which prefix that is does not depend on the executor either.
 """
 
 from __future__ import annotations
@@ -21,26 +25,47 @@ __all__ = ["EXECUTORS", "run_parallel"]
 EXECUTORS = ("process", "ray")
 
 
-def run_parallel(fn: Callable, jobs: list, workers: int | None = None) -> list:
+def run_parallel(
+    fn: Callable, jobs: list, workers: int | None = None, stop: Callable | None = None
+) -> list:
     """``[fn(j) for j in jobs]`` on the configured executor.
 
     ``IMITWALK_WORKERS`` overrides the default worker count (one per core) of the process
-    pool; ``workers=1`` (or a single job) runs in this process.
+    pool; ``workers=1`` (or a single job) runs in this process. ``stop(results) -> bool``,
+    if given, is asked after each result in job order; once it says True, the rest of
+    the jobs are cancelled (those already running finish, unused) and the results so far
+    are returned: the shortest prefix of ``[fn(j) for j in jobs]`` that ``stop`` accepts.
     """
     executor = os.environ.get("IMITWALK_EXECUTOR", "process")
     if executor not in EXECUTORS:
         raise unknown_name("IMITWALK_EXECUTOR", executor, EXECUTORS, ConfigError)
     if executor == "ray" and len(jobs) > 1 and workers != 1:
-        return _ray_map(fn, jobs)
+        return _ray_map(fn, jobs, stop)
     default = int(os.environ.get("IMITWALK_WORKERS", 0)) or os.cpu_count() or 1
     workers = min(len(jobs), workers or default)
     if workers <= 1:
-        return [fn(j) for j in jobs]
+        return _until(jobs, fn, stop)
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(fn, jobs))
+        if stop is None:
+            return list(pool.map(fn, jobs))
+        futures = [pool.submit(fn, j) for j in jobs]
+        out = _until(futures, lambda f: f.result(), stop)
+        for f in futures[len(out) :]:
+            f.cancel()
+        return out
 
 
-def _ray_map(fn: Callable, jobs: list) -> list:
+def _until(pending, get: Callable, stop: Callable | None) -> list:
+    """``[get(p) for p in pending]``, ended after the first prefix ``stop`` accepts."""
+    out: list = []
+    for p in pending:
+        out.append(get(p))
+        if stop is not None and stop(out):
+            break
+    return out
+
+
+def _ray_map(fn: Callable, jobs: list, stop: Callable | None = None) -> list:
     try:
         import ray
     except ImportError:
@@ -53,4 +78,10 @@ def _ray_map(fn: Callable, jobs: list) -> list:
             configure_logging=False,
         )
     task = ray.remote(fn)
-    return ray.get([task.remote(j) for j in jobs])
+    refs = [task.remote(j) for j in jobs]
+    if stop is None:
+        return ray.get(refs)
+    out = _until(refs, ray.get, stop)
+    for r in refs[len(out) :]:
+        ray.cancel(r)
+    return out

@@ -68,6 +68,7 @@ def play_reference(
     workers: int | None = None,
     engine: str = "mujoco",
     disturbance: bool = False,
+    stop=None,
 ) -> list[ModelRun]:
     """Play ``ref`` at ``scale`` open loop for ``seconds`` on the robots ``seeds``.
 
@@ -79,13 +80,15 @@ def play_reference(
         workers: parallel processes (default: one per core; 1 runs in this process).
         engine: physics engine, one of :data:`imitwalk.sim.ENGINES`.
         disturbance: give the perturbed robots the evaluation's small initial push too.
+        stop: ``stop(runs) -> bool``, asked after each robot in ``seeds`` order: once it
+            holds, the robots not yet run are skipped (:func:`imitwalk.parallel.run_parallel`).
     """
     q = ref.trajectory(scale, seconds)
     base = ref.sim_options(base)  # on the ground the gait was built for
     expected = _Expected(ref, scale)
     opts = [perturbed(s, base, disturbance=disturbance and s != 0) for s in seeds]
     jobs = [(robot, q, q[0], o, expected, s, engine) for s, o in zip(seeds, opts, strict=True)]
-    return run_parallel(_one, jobs, workers)
+    return run_parallel(_one, jobs, workers, stop)
 
 
 def summary(runs: list[ModelRun]) -> dict:

@@ -22,6 +22,13 @@ after ``refine_rounds`` rounds, earlier when a whole round keeps nothing or when
 falls. Like the search it uses training robots only (:func:`imitwalk.perturb.train_seeds`),
 never an evaluation robot, and no dynamics model: it measures.
 
+A nudge is kept only if it falls less often than the set it must beat, so once its falls
+pass that set's it cannot be kept, whatever its remaining robots do. With
+``refine_early_stop`` (on by default) its trial stops there: the longest stride, where
+most falls are, is played first, and the robots not yet run are skipped. The nudges kept,
+and so the reference, are the same as with every robot played; only the rejected
+trials' counts become lower bounds (``complete`` false), and the refinement costs less.
+
 :func:`refine_per_scale` (``refine_per_scale``) runs the same search once per scale of
 ``refine_scales``, each judged at its own scale only and starting from the searched
 set, so that the reference can be solved with each scale's own set there
@@ -73,7 +80,10 @@ class RefineTrial:
         mean_abs_yaw_deg: mean |heading drift| [deg]; kept: whether it was kept;
         repeat: the set was played before (a later round came back to it), and its
         measurement was reused (the runs are deterministic); at: the one scale it was
-        judged at (per-scale refinement; ``None``: every one of ``refine_scales``).
+        judged at (per-scale refinement; ``None``: every one of ``refine_scales``);
+        complete: every robot was played (false: the trial stopped once it fell more
+        often than the set it had to beat, so ``falls`` is a lower bound and ``robots``
+        the runs played).
     """
 
     params: dict
@@ -86,6 +96,7 @@ class RefineTrial:
     kept: bool = False
     repeat: bool = False
     at: float | None = None
+    complete: bool = True
 
     def beats(self, other: RefineTrial, start: RefineTrial, yaw_slack: float | None) -> bool:
         """Fewer falls than ``other`` (or as many, and longer up), at no great cost in
@@ -133,17 +144,22 @@ def refine_params(
     trials: list[RefineTrial] = []
     played: dict[tuple, RefineTrial] = {}
 
-    def trial(p: GaitParams, changed: str) -> RefineTrial:
+    def trial(p: GaitParams, changed: str, bound: int | None = None) -> RefineTrial:
+        """Play ``p``; with ``bound`` (and early stop on), stop once it falls more often."""
         key = tuple(p.to_dict().values())
-        if key in played:
+        if key in played:  # a partial count stays above any later set to beat: falls only drop
             out = replace(played[key], changed=changed, repeat=True)
             trials.append(out)
             return out
         ref = build_walkable(template, robot, p, scales, dt, ik=ik, command=command).reference
-        ms = [
-            r.metrics
-            for s in scales
-            for r in play_reference(
+        race = bound is not None and config.refine_early_stop
+        runs: dict[float, list] = {}
+        fell = 0
+        for s in sorted(scales, reverse=True):  # the longest stride falls most: first
+            stop = (
+                (lambda rs, f=fell: f + sum(r.metrics.fell for r in rs) > bound) if race else None
+            )
+            runs[s] = play_reference(
                 ref,
                 robot,
                 s,
@@ -153,8 +169,12 @@ def refine_params(
                 config.workers,
                 config.engine,
                 disturbance=True,
+                stop=stop,
             )
-        ]
+            fell += sum(r.metrics.fell for r in runs[s])
+            if race and fell > bound:
+                break
+        ms = [r.metrics for s in scales for r in runs.get(s, [])]  # in scale order, as counted
         out = RefineTrial(
             params=p.to_dict(),
             changed=changed,
@@ -164,6 +184,7 @@ def refine_params(
             mean_progress=float(np.mean([m.progress_ratio for m in ms])),
             mean_abs_yaw_deg=float(np.mean([abs(m.yaw_drift_deg) for m in ms])),
             at=at,
+            complete=len(ms) == len(scales) * len(seeds),
         )
         trials.append(out)
         played[key] = out
@@ -188,7 +209,7 @@ def refine_params(
                 if abs(x - getattr(current, name)) < 1e-12:
                     continue  # at its bound
                 cand = replace(current, **{name: x})
-                t = trial(cand, name + tag)
+                t = trial(cand, name + tag, bound=best.falls)
                 keep = t.beats(best, start, config.refine_yaw_slack)
                 report(t, keep)
                 if keep:
@@ -208,14 +229,13 @@ def refine_params(
         "steps": STEPS,
         "progress_slack": PROGRESS_SLACK,
         "yaw_slack_deg": config.refine_yaw_slack,
+        "early_stop": config.refine_early_stop,
         "trials": [asdict(r) for r in rows],
+        "stopped_early": sum(not (r.complete or r.repeat) for r in rows),
         "start_falls": rows[0].falls,
         "falls": best.falls,
         "params": current.to_dict(),
-        "sim_seconds": sum(not r.repeat for r in rows)
-        * len(scales)
-        * len(seeds)
-        * config.refine_seconds,
+        "sim_seconds": sum(r.robots for r in rows if not r.repeat) * config.refine_seconds,
         "wall_seconds": time.perf_counter() - t0,
     }
     return current, out
@@ -250,6 +270,7 @@ def refine_per_scale(
         "start_falls": sum(r["start_falls"] for r in reports),
         "falls": sum(r["falls"] for r in reports),
         "trials": [t for r in reports for t in r["trials"]],
+        "stopped_early": sum(r["stopped_early"] for r in reports),
         "sim_seconds": sum(r["sim_seconds"] for r in reports),
         "wall_seconds": sum(r["wall_seconds"] for r in reports),
         "per_scale": {f"{s:g}": r for s, r in zip(scales, reports, strict=True)},

@@ -74,7 +74,9 @@ class SearchConfig:
             the searched reference's (``None``: heading not guarded); refine_per_scale:
             refine each of ``refine_scales`` on its own, judged there alone, and solve
             the reference with each one's set at that scale
-            (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales).
+            (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales);
+            refine_early_stop: stop a nudge's trial once it has fallen more often than the
+            set it must beat (the same nudges are kept; see :mod:`imitwalk.retarget.refine`).
     """
 
     generations: int = 5
@@ -95,6 +97,7 @@ class SearchConfig:
     refine_seconds: float = 30.0
     refine_yaw_slack: float | None = None
     refine_per_scale: bool = False
+    refine_early_stop: bool = True
 
     def __post_init__(self):
         if self.engine not in ENGINES:
