@@ -7,6 +7,7 @@ its yaw drift stays under 15°. Robots are simulated in parallel worker processe
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +69,7 @@ def play_reference(
     workers: int | None = None,
     engine: str = "mujoco",
     disturbance: bool = False,
-    stop=None,
+    stop: Callable[[list[ModelRun]], bool] | None = None,
 ) -> list[ModelRun]:
     """Play ``ref`` at ``scale`` open loop for ``seconds`` on the robots ``seeds``.
 
