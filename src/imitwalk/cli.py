@@ -12,6 +12,7 @@ import sys
 from collections.abc import Sequence
 
 from imitwalk import commands
+from imitwalk.config import RECIPES
 from imitwalk.errors import ImitwalkError
 from imitwalk.simtypes import ENGINES
 
@@ -129,6 +130,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="extended (default) or the paper as written (faithful)",
     )
     ln.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    ln.add_argument(
+        "--recipe",
+        metavar="NAME|FILE",
+        help="a named set of settings, applied before --set: "
+        + ", ".join(RECIPES)
+        + " (docs/RESULTS.md), or a file of key=value lines",
+    )
     ln.add_argument("--resume", action="store_true", help="continue an interrupted run")
     ln.add_argument(
         "--set",

@@ -187,7 +187,7 @@ def _with_command(cfg, args: argparse.Namespace):
 
 
 def learn(args: argparse.Namespace) -> int:
-    from imitwalk.config import apply_overrides
+    from imitwalk.config import apply_overrides, recipe_settings
     from imitwalk.errors import ConfigError
     from imitwalk.learnconfig import preset
     from imitwalk.learner import learn as run
@@ -196,17 +196,23 @@ def learn(args: argparse.Namespace) -> int:
     from imitwalk.runs import RunDir
 
     robot = robot_from(args)
-    rt_set, learn_set = _split_settings(args.set)
+    recipe = recipe_settings(args.recipe) if args.recipe else []
+    rt_set, learn_set = _split_settings(recipe + args.set)
     cfg = apply_overrides(preset(args.variant, seed=args.seed), learn_set)
     rd = RunDir(args.out)
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
-    if flags and (args.reference or (args.resume and rd.exists("reference.npz"))):
+    given = args.reference or (args.resume and rd.exists("reference.npz"))
+    if flags and given:
         raise ConfigError(
             f"{', '.join(flags)} shape a new reference; a given or resumed reference keeps "
             "the command it was built with (retarget again with them)"
         )
+    rcfg = apply_overrides(RetargetConfig(), rt_set)  # checked even where it is not used
+    if rt_set and given:
+        unused = ", ".join(f"retarget.{i}" for i in rt_set)
+        progress(f"learn: {unused}: not used, the reference is given as it is")
     if args.resume and rd.exists("reference.npz"):
         ref = Reference.load(rd.file("reference.npz"))
         progress(f"learn: resuming {rd.path}")
@@ -215,7 +221,7 @@ def learn(args: argparse.Namespace) -> int:
     else:
         motion = _motion(args)
         progress(f"learn: retargeting {motion.source}")
-        rcfg = _with_command(apply_overrides(RetargetConfig(), rt_set), args)
+        rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
         ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
         ref.settings["robot"] = args.robot
