@@ -127,10 +127,10 @@ def recipe_settings(name: str) -> list[str]:
             line that is not ``key=value``.
     """
     if name in RECIPES:
-        text, where = resources.files("imitwalk.recipes").joinpath(f"{name}.txt").read_text(), name
+        text = resources.files("imitwalk.recipes").joinpath(f"{name}.txt").read_text()
     elif Path(name).is_file():
         try:
-            text, where = Path(name).read_text(), name
+            text = Path(name).read_text()
         except (OSError, UnicodeDecodeError) as exc:
             raise ConfigError(f"recipe {name}: cannot be read ({exc})") from None
     else:
@@ -142,6 +142,6 @@ def recipe_settings(name: str) -> list[str]:
         if not line:
             continue
         if "=" not in line:
-            raise ConfigError(f"recipe {where}, line {n}: {line!r} is not key=value")
+            raise ConfigError(f"recipe {name}, line {n}: {line!r} is not key=value")
         out.append(line)
     return out
