@@ -147,8 +147,7 @@ def refine_report(done: int, total: int, trial) -> None:
     """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
     what = (trial.changed or "searched") + ("" if trial.at is None else f" at {trial.at:g}")
     mark = " (kept)" if trial.changed and trial.kept else ""
-    if not trial.complete:
-        mark = " (stopped: falls more than the set to beat)"
+    mark = mark if trial.complete else " (stopped: falls more than the set to beat)"
     progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
 
 
@@ -203,7 +202,8 @@ def learn(args: argparse.Namespace) -> int:
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
-    given = args.reference or (args.resume and rd.exists("reference.npz"))
+    resumed = args.resume and rd.exists("reference.npz")
+    given = args.reference or resumed
     if flags and given:
         raise ConfigError(
             f"{', '.join(flags)} shape a new reference; a given or resumed reference keeps "
@@ -213,7 +213,7 @@ def learn(args: argparse.Namespace) -> int:
     if rt_set and given:
         unused = ", ".join(f"retarget.{i}" for i in rt_set)
         progress(f"learn: {unused}: not used, the reference is given as it is")
-    if args.resume and rd.exists("reference.npz"):
+    if resumed:
         ref = Reference.load(rd.file("reference.npz"))
         progress(f"learn: resuming {rd.path}")
     elif args.reference:

@@ -107,6 +107,11 @@ class RefineTrial:
         return better and straight and self.mean_progress >= other.mean_progress - PROGRESS_SLACK
 
 
+def _falls(runs) -> int:
+    """How many of ``runs`` (:class:`~imitwalk.playback.ModelRun`) fell."""
+    return sum(r.metrics.fell for r in runs)
+
+
 def refine_params(
     template: GaitTemplate,
     robot: Robot,
@@ -145,20 +150,17 @@ def refine_params(
     played: dict[tuple, RefineTrial] = {}
 
     def trial(p: GaitParams, changed: str, bound: int | None = None) -> RefineTrial:
-        """Play ``p``; with ``bound`` (and early stop on), stop once it falls more often."""
+        """Play ``p``; with ``bound``, stop once it has fallen more often than that."""
         key = tuple(p.to_dict().values())
         if key in played:  # a partial count stays above any later set to beat: falls only drop
             out = replace(played[key], changed=changed, repeat=True)
             trials.append(out)
             return out
         ref = build_walkable(template, robot, p, scales, dt, ik=ik, command=command).reference
-        race = bound is not None and config.refine_early_stop
         runs: dict[float, list] = {}
         fell = 0
         for s in sorted(scales, reverse=True):  # the longest stride falls most: first
-            stop = (
-                (lambda rs, f=fell: f + sum(r.metrics.fell for r in rs) > bound) if race else None
-            )
+            stop = None if bound is None else (lambda rs, f=fell: f + _falls(rs) > bound)
             runs[s] = play_reference(
                 ref,
                 robot,
@@ -171,8 +173,8 @@ def refine_params(
                 disturbance=True,
                 stop=stop,
             )
-            fell += sum(r.metrics.fell for r in runs[s])
-            if race and fell > bound:
+            fell += _falls(runs[s])
+            if bound is not None and fell > bound:
                 break
         ms = [r.metrics for s in scales for r in runs.get(s, [])]  # in scale order, as counted
         out = RefineTrial(
@@ -209,7 +211,7 @@ def refine_params(
                 if abs(x - getattr(current, name)) < 1e-12:
                     continue  # at its bound
                 cand = replace(current, **{name: x})
-                t = trial(cand, name + tag, bound=best.falls)
+                t = trial(cand, name + tag, best.falls if config.refine_early_stop else None)
                 keep = t.beats(best, start, config.refine_yaw_slack)
                 report(t, keep)
                 if keep:
