@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import pytest
 
 from imitwalk.errors import ConfigError
+from imitwalk.parallel import run_parallel
 from imitwalk.perturb import TRAIN_SEED_BASE
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.retarget import refine as refine_mod
@@ -29,15 +30,11 @@ def _falls(p: dict) -> int:
 
 
 def _stops(play):
-    """``play`` with the real playback's ``stop``: the shortest prefix of its runs, in
-    seed order, that ``stop`` accepts."""
+    """``play`` with the real playback's ``stop``: its runs go through
+    :func:`imitwalk.parallel.run_parallel` (in this process) as the robots' jobs would."""
 
     def with_stop(*args, stop=None, **kw):
-        runs = play(*args, **kw)
-        for i in range(len(runs)):
-            if stop is not None and stop(runs[: i + 1]):
-                return runs[: i + 1]
-        return runs
+        return run_parallel(lambda run: run, play(*args, **kw), workers=1, stop=stop)
 
     return with_stop
 
