@@ -86,6 +86,11 @@ def build_parser() -> argparse.ArgumentParser:
     stand.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (10)")
     stand.add_argument("--json", action="store_true", help="print JSON")
     stand.set_defaults(func=commands.robot_stand)
+    imp = rsub.add_parser("import", help="draft a joint map from an MJCF file (never edits it)")
+    imp.add_argument("mjcf", help="the robot's MJCF .xml")
+    imp.add_argument("--out", required=True, help="the joint map to write (.json)")
+    imp.add_argument("--json", action="store_true", help="print JSON")
+    imp.set_defaults(func=commands.robot_import)
 
     rt = sub.add_parser("retarget", help="mocap -> robot joint trajectory (.npz)")
     _mocap_args(rt)

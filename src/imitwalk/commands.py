@@ -7,7 +7,16 @@ import json
 import sys
 from pathlib import Path
 
-__all__ = ["emit", "playback", "progress", "retarget", "robot_from", "robot_info", "robot_stand"]
+__all__ = [
+    "emit",
+    "playback",
+    "progress",
+    "retarget",
+    "robot_from",
+    "robot_import",
+    "robot_info",
+    "robot_stand",
+]
 
 
 def emit(obj: dict, as_json: bool) -> None:
@@ -85,11 +94,43 @@ def robot_info(args: argparse.Namespace) -> int:
 
 
 def robot_stand(args: argparse.Namespace) -> int:
+    from imitwalk.errors import RobotError
     from imitwalk.standing import stand_test
 
-    res = stand_test(robot_from(args), seconds=args.seconds)
+    robot = robot_from(args)
+    res = stand_test(robot, seconds=args.seconds)
+    if res.fell:
+        raise RobotError(res.refusal(robot.name))
     emit(res.to_dict(), args.json)
-    return 1 if res.fell else 0
+    return 0
+
+
+def robot_import(args: argparse.Namespace) -> int:
+    from imitwalk.errors import RobotError
+    from imitwalk.fileio import atomic_write
+    from imitwalk.robots.draft import draft_joint_map
+
+    out, mjcf = Path(args.out), Path(args.mjcf)
+    if out.is_dir():
+        raise RobotError(f"--out {out} is a folder; give the joint map's file name")
+    if out.exists() and mjcf.exists() and out.resolve() == mjcf.resolve():
+        raise RobotError(f"--out {out} is the MJCF file itself; imitwalk never edits it")
+    draft = draft_joint_map(mjcf, out)
+    for line in draft.lines:
+        progress(f"  {line}")
+    atomic_write(out, lambda tmp: tmp.write_text(json.dumps(draft.jmap, indent=2) + "\n"))
+    r = draft.robot
+    summary = {
+        "out": str(out),
+        "name": r.name,
+        "dof": r.dof,
+        "roles": list(r.joint_names),
+        "total_mass_kg": r.total_mass,
+        "standing_height_m": r.height,
+        "stand": draft.stand.to_dict(),
+    }
+    emit(summary, args.json)
+    return 0
 
 
 def _motion(args: argparse.Namespace):
