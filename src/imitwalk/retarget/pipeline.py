@@ -19,6 +19,7 @@ from imitwalk.mocap.motion import Motion
 from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.human import build_paper
+from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.refine import refine_params, refine_per_scale
@@ -160,13 +161,14 @@ def retarget(
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
         report = {}
     else:
-        params, report, own = cfg.params, {}, None
+        # a lift left unset is a tenth of this robot's leg
+        params, report, own = cfg.params.for_leg(leg_geometry(robot).leg), {}, None
         if cfg.search:
             params, report = search_params(
                 template,
                 robot,
                 cfg.search_config,
-                cfg.params,
+                params,
                 dt,
                 progress=progress,
                 command=cfg.command,
