@@ -155,13 +155,21 @@ def retarget(args: argparse.Namespace) -> int:
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
-    res.reference.settings["robot"] = args.robot
-    res.reference.settings["joint_map"] = args.joint_map
+    res.reference.settings["robot"] = _where(args.robot)
+    res.reference.settings["joint_map"] = _where(args.joint_map)
     res.reference.save(args.out)
     stats = res.stats()
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
+
+
+def _where(robot: str | None) -> str | None:
+    """A robot as a reference records it: a built-in name as it is, a file as an absolute
+    path (so that the reference plays from any working directory)."""
+    if robot is None or not Path(robot).is_file():
+        return robot
+    return str(Path(robot).resolve())
 
 
 def _announce_search(cfg) -> None:
@@ -265,8 +273,8 @@ def learn(args: argparse.Namespace) -> int:
         rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
         ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
-        ref.settings["robot"] = args.robot
-        ref.settings["joint_map"] = args.joint_map
+        ref.settings["robot"] = _where(args.robot)
+        ref.settings["joint_map"] = _where(args.joint_map)
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
     keys = (

@@ -2,10 +2,10 @@
 
 :func:`plan_additions` checks every name of a :class:`~imitwalk.robots.jointmap.JointMap`
 against the user's own model and decides what to add when the model is built: a floor
-and a light if the file has none, the joint map's sole sites, four touch sensors under
-each sole if the map names no foot sensors, an IMU on the torso if it names no gyro (an
-accelerometer at the gyro if it names none), and position servos where a joint has a
-motor actuator or none (:mod:`imitwalk.robots.servos`).
+if the file has none (and, for rendering, a light from above and a sky), the joint map's
+sole sites, four touch sensors under each sole if the map names no foot sensors, an IMU
+on the torso if it names no gyro (an accelerometer at the gyro if it names none), and
+position servos where a joint has a motor actuator or none (:mod:`imitwalk.robots.servos`).
 """
 
 from __future__ import annotations
@@ -205,7 +205,8 @@ def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf) -> tuple[Additions
     )
     add = Additions(
         floor=floor,
-        light=model.nlight == 0,
+        light=not (model.light_type == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL).any(),
+        sky=not (model.tex_type == mujoco.mjtTexture.mjTEXTURE_SKYBOX).any(),
         soles=tuple(added_soles),
         pads=tuple(pads),
         imu=imu,

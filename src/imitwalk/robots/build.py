@@ -66,7 +66,8 @@ class Additions:
     """What imitwalk adds to a user's MJCF (all hashable, so a model can be cached).
 
     Attributes:
-        floor, light: add a floor plane that touches every colliding geom, and a light.
+        floor: add a floor plane that touches every colliding geom; light, sky: add a
+            light shining down and a sky (for rendering).
         soles: ``(site name, SoleSpec)`` sole sites to add.
         pads: :class:`TouchPads` to add.
         imu: ``(body, site, pos, quat)`` an IMU site to add (``None``: none).
@@ -76,6 +77,7 @@ class Additions:
 
     floor: bool = False
     light: bool = False
+    sky: bool = False
     soles: tuple[tuple[str, SoleSpec], ...] = ()
     pads: tuple[TouchPads, ...] = ()
     imu: tuple[str, str, tuple, tuple] | None = None
@@ -195,6 +197,16 @@ def apply(spec: mujoco.MjSpec, add: Additions, model: mujoco.MjModel) -> None:
     """Add to ``spec`` (the file's, compiled as ``model``) what ``add`` lists."""
     if add.floor:
         _add_floor(spec, model)
+    if add.sky:
+        spec.add_texture(
+            name=free_name({t.name for t in spec.textures}, "imitwalk_sky"),
+            type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+            builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+            rgb1=[0.78, 0.85, 0.93],
+            rgb2=[0.97, 0.98, 1.0],
+            width=256,
+            height=256,
+        )
     if add.light:
         spec.worldbody.add_light(
             name=free_name({x.name for x in spec.lights}, "imitwalk_sun"),
