@@ -7,6 +7,8 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
+
 __all__ = [
     "emit",
     "playback",
@@ -19,10 +21,13 @@ __all__ = [
 ]
 
 
-def emit(obj: dict, as_json: bool) -> None:
-    """Print ``obj`` as JSON, or as aligned ``key: value`` lines."""
+def emit(obj: dict, as_json: bool, finite: bool = False) -> None:
+    """Print ``obj`` as JSON, or as aligned ``key: value`` lines; ``finite``: a NaN or an
+    infinity (a servo without a torque limit) is printed as ``null``, so the JSON is valid."""
+    if finite:
+        obj = _finite(obj)
     if as_json:
-        print(json.dumps(obj, indent=2, default=_plain))
+        print(json.dumps(obj, indent=2, default=_plain, allow_nan=not finite))
         return
     for key, val in obj.items():
         if isinstance(val, dict | list):
@@ -31,6 +36,17 @@ def emit(obj: dict, as_json: bool) -> None:
         elif isinstance(val, float):
             val = f"{val:.4g}"
         print(f"{key:>28}: {val}")
+
+
+def _finite(v):
+    """``v`` with every non-finite float (also in dicts and lists) replaced by ``None``."""
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_finite(x) for x in v]
+    if isinstance(v, float | np.floating) and not np.isfinite(v):
+        return None
+    return v
 
 
 def _plain(v):
@@ -89,6 +105,7 @@ def robot_info(args: argparse.Namespace) -> int:
             "physics_hz": opt.physics_hz,
         },
         args.json,
+        finite=True,
     )
     return 0
 
@@ -101,7 +118,7 @@ def robot_stand(args: argparse.Namespace) -> int:
     res = stand_test(robot, seconds=args.seconds)
     if res.fell:
         raise RobotError(res.refusal(robot.name))
-    emit(res.to_dict(), args.json)
+    emit(res.to_dict(), args.json, finite=True)
     return 0
 
 
@@ -129,7 +146,7 @@ def robot_import(args: argparse.Namespace) -> int:
         "standing_height_m": r.height,
         "stand": draft.stand.to_dict(),
     }
-    emit(summary, args.json)
+    emit(summary, args.json, finite=True)
     return 0
 
 
