@@ -199,3 +199,15 @@ def test_hoap2_keeps_its_tables_exactly(robot):
     assert leg == pytest.approx(REFERENCE_LEG)
     assert bounds(leg) == BOUNDS and GaitParams().for_leg(leg).lift == LIFT == 0.02
     assert bounds(0.6)["lift"] == (0.045, 0.135) and bounds(0.6)["sway"] == BOUNDS["sway"]
+
+
+def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
+    """evaluate and report load the robot a run's reference records (a file), not its name."""
+    from imitwalk.commands import _run_robot
+    from imitwalk.runs import RunDir
+
+    ref, _ = tiny_reference
+    ref.settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
+    ref.save(tmp_path / "reference.npz")
+    (tmp_path / "config.json").write_text(json.dumps({"robot": "op3"}))
+    assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)

@@ -322,8 +322,8 @@ def evaluate(args: argparse.Namespace) -> int:
     check_gain(args.gain)
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
-    ref_settings = cfg.get("reference", {})
-    args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
+    if args.robot is None:
+        args.robot, args.joint_map = _run_robot(rd, cfg)
     learned_on = cfg.get("learn", {}).get("engine", "mujoco")
     args.engine = args.engine or learned_on
     robot = robot_from(args)
@@ -339,6 +339,18 @@ def evaluate(args: argparse.Namespace) -> int:
     rd.write_json(_result_name(kind, args, learned_on), out)
     emit(out, args.json)
     return 0
+
+
+def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
+    """The robot a run learned on and its joint map: the file its reference records (a
+    built-in name, or the joint map's path), else the name in its ``config.json``."""
+    from imitwalk.retarget import Reference
+
+    settings = (
+        Reference.load(rd.file("reference.npz")).settings if rd.exists("reference.npz") else {}
+    )
+    name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
+    return name or "hoap2", settings.get("joint_map")
 
 
 def _result_name(kind: str, args: argparse.Namespace, learned_on: str) -> str:
