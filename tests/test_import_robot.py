@@ -206,8 +206,10 @@ def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     from imitwalk.commands import _run_robot
     from imitwalk.runs import RunDir
 
-    ref, _ = tiny_reference
-    ref.settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
-    ref.save(tmp_path / "reference.npz")
+    from dataclasses import replace
+
+    ref, _ = tiny_reference  # shared: a copy with other settings
+    settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
+    replace(ref, settings=settings).save(tmp_path / "reference.npz")
     (tmp_path / "config.json").write_text(json.dumps({"robot": "op3"}))
     assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)
