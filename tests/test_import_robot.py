@@ -203,10 +203,10 @@ def test_hoap2_keeps_its_tables_exactly(robot):
 
 def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     """evaluate and report load the robot a run's reference records (a file), not its name."""
+    from dataclasses import replace
+
     from imitwalk.commands import _run_robot
     from imitwalk.runs import RunDir
-
-    from dataclasses import replace
 
     ref, _ = tiny_reference  # shared: a copy with other settings
     settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
