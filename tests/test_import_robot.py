@@ -201,6 +201,16 @@ def test_hoap2_keeps_its_tables_exactly(robot):
     assert bounds(0.6)["lift"] == (0.045, 0.135) and bounds(0.6)["sway"] == BOUNDS["sway"]
 
 
+def test_a_sidestep_is_held_to_the_robot_s_leg():
+    from imitwalk.errors import ConfigError
+    from imitwalk.retarget.command import GaitCommand, check_side
+
+    check_side(GaitCommand(side_m=0.05), 0.2)  # hoap2's limit, as before
+    with pytest.raises(ConfigError, match=r"expected -0.05 <= side_m <= 0.05 \(scaled"):
+        check_side(GaitCommand(side_m=0.06), 0.2)
+    check_side(GaitCommand(side_m=0.15), 0.6)  # a leg three times as long
+
+
 def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     """evaluate and report load the robot a run's reference records (a file), not its name."""
     from dataclasses import replace

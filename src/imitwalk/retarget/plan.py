@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.errors import ConfigError
-from imitwalk.retarget.command import GaitCommand, cycle_motion, place, walking_frame
+from imitwalk.retarget.command import GaitCommand, check_side, cycle_motion, place, walking_frame
 from imitwalk.retarget.params import GaitParams, LegGeometry, leg_scaled
 from imitwalk.retarget.template import GaitTemplate
 
@@ -136,6 +136,7 @@ def plan_walk(
     """
     cmd = command or GaitCommand()
     params = params.for_leg(geom.leg)
+    check_side(cmd, geom.leg)
     n_cyc = max(2, round(template.period / dt))
     period = n_cyc * dt
     stride = cmd.forward * scale * template.stride * geom.leg / template.leg_length
