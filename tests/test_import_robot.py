@@ -223,3 +223,17 @@ def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     replace(ref, settings=settings).save(tmp_path / "reference.npz")
     (tmp_path / "config.json").write_text(json.dumps({"robot": "op3"}))
     assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)
+
+
+def test_importing_hoap2_gives_back_its_own_joint_map(tmp_path, capsys):
+    """The drafted map of hoap2.xml is the hand-written hoap2.json (roles, signs, sensors in
+    front-left, front-right, rear-left, rear-right order, soles, torso, keyframe)."""
+    from imitwalk.robots import BUILTIN
+
+    out = tmp_path / "hoap2.json"
+    xml = BUILTIN["hoap2"].parent / "hoap2.xml"
+    assert main(["robot", "import", str(xml), "--out", str(out)]) == 0
+    capsys.readouterr()
+    drafted, own = json.loads(out.read_text()), json.loads(BUILTIN["hoap2"].read_text())
+    assert drafted.pop("mjcf").endswith("hoap2.xml") and own.pop("mjcf") == "hoap2.xml"
+    assert drafted == own

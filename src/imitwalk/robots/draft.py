@@ -44,9 +44,15 @@ class Draft:
     stand: object
 
 
-def _sole(tree: Tree, body: int, bodies: list[int]) -> dict:
-    """The sole under ``bodies`` as a joint map entry: a site on ``body``, in its frame."""
+def _sole(tree: Tree, body: int, bodies: list[int]) -> dict | str:
+    """The sole under ``bodies`` as a joint map entry: a site the file has at its centre
+    (within a hundredth of the foot's length), else a site to add on ``body``."""
     fp = footprint(tree.model, tree.data, bodies)
+    m, d = tree.model, tree.data
+    near = [i for i in range(m.nsite) if m.site_bodyid[i] in bodies and m.site(i).name]
+    near = [i for i in near if np.linalg.norm(d.site_xpos[i] - fp.centre) < 0.02 * fp.half[0]]
+    if near:
+        return m.site(near[0]).name
     rot = tree.data.xmat[body].reshape(3, 3)
     pos = rot.T @ (fp.centre - tree.data.xpos[body])
     quat = np.zeros(4)
@@ -146,6 +152,9 @@ def draft_joint_map(mjcf: str | Path, out: str | Path) -> Draft:
     jmap["soles"] = {s: _sole(tree, *sk.feet[s]) for s in ("l", "r")}
     for s in ("l", "r"):
         e = jmap["soles"][s]
+        if isinstance(e, str):
+            lines.append(f"guessed {s} sole: the site {e} (at the centre of the foot's geoms)")
+            continue
         lines.append(
             f"guessed {s} sole: {e['size'][0] * 2:.3f} x {e['size'][1] * 2:.3f} m "
             f"under {e['body']} (from its collision geoms)"
