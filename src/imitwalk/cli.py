@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from imitwalk import commands
 from imitwalk.config import RECIPES
 from imitwalk.errors import ImitwalkError
+from imitwalk.protocol import PROTOCOLS
 from imitwalk.simtypes import ENGINES
 
 __all__ = ["build_parser", "main"]
@@ -153,7 +154,12 @@ def build_parser() -> argparse.ArgumentParser:
     ev = sub.add_parser("evaluate", help="learned gait vs open-loop playback on perturbed robots")
     ev.add_argument("run_dir", help="a run folder written by learn")
     ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
-    ev.add_argument("--seeds", type=int, default=10, help="robots: nominal + perturbed (10)")
+    ev.add_argument("--seeds", type=int, default=None, help="robots (10; 40 with --protocol)")
+    ev.add_argument(
+        "--protocol",
+        metavar="NAME|FILE",
+        help="judge on a robustness protocol: " + ", ".join(PROTOCOLS) + ", or a protocol .json",
+    )
     ev.add_argument(
         "--scale", type=float, default=None, help="judge at this scale (default: the one reached)"
     )

@@ -249,6 +249,7 @@ def learn(args: argparse.Namespace) -> int:
 
 
 def evaluate(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError
     from imitwalk.evaluate import check_gain, evaluate_run
     from imitwalk.robustness import robustness_grid
     from imitwalk.runs import RunDir
@@ -259,8 +260,13 @@ def evaluate(args: argparse.Namespace) -> int:
     ref_settings = cfg.get("reference", {})
     args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
     learned_on = cfg.get("learn", {}).get("engine", "mujoco")
+    if args.protocol is not None:
+        if args.engine is not None:
+            raise ConfigError("--engine: a protocol names its own engine (e.g. --protocol bullet)")
+        return _evaluate_protocol(args, rd, robot_from(args))
     args.engine = args.engine or learned_on
     robot = robot_from(args)
+    args.seeds = 10 if args.seeds is None else args.seeds
     common = {"workers": args.workers, "scale": args.scale, "engine": args.engine}
     common["gain"] = args.gain
     if args.perturb:
@@ -271,6 +277,38 @@ def evaluate(args: argparse.Namespace) -> int:
         out = evaluate_run(rd.path, robot, args.seconds, args.seeds, **common)
     kind = "robustness" if args.perturb else "evaluation"
     rd.write_json(_result_name(kind, args, learned_on), out)
+    emit(out, args.json)
+    return 0
+
+
+def _evaluate_protocol(args: argparse.Namespace, rd, robot) -> int:
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge import judge_protocol
+    from imitwalk.protocol import load_protocol
+
+    protocol = load_protocol(args.protocol)
+    if args.perturb:
+        raise ConfigError("--protocol and --perturb are two evaluations; give one")
+    seeds = 40 if args.seeds is None else args.seeds
+    if seeds < 1 or not args.seconds > 0:
+        raise ConfigError(f"--seeds {seeds} --seconds {args.seconds:g}: expected >= 1 and > 0")
+    progress(
+        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
+        f"{seeds} robots x {args.seconds:g} s"
+    )
+    out = judge_protocol(
+        rd.path, robot, protocol, seeds, args.seconds, scale=args.scale,
+        workers=args.workers, gain=args.gain,
+    )  # fmt: skip
+    for name, side in out["controllers"].items():
+        lo, hi = side["survival_ci95"]
+        progress(
+            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
+            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+        )
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
     emit(out, args.json)
     return 0
 
