@@ -96,7 +96,13 @@ def _motion(args: argparse.Namespace):
     from imitwalk.mocap import default_clip, load_motion
 
     path = args.file or default_clip()
-    return load_motion(path, skeleton=args.skeleton, units=getattr(args, "units", None))
+    return load_motion(
+        path,
+        skeleton=args.skeleton,
+        units=getattr(args, "units", None),
+        up=getattr(args, "up", None),
+        joint_names=getattr(args, "joint_names", None),
+    )
 
 
 def retarget(args: argparse.Namespace) -> int:

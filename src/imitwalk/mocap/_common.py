@@ -27,7 +27,6 @@ __all__ = [
     "quat_wxyz_matrices",
     "read_lines",
     "snap_rate",
-    "up_axis",
     "z_up",
 ]
 
@@ -138,21 +137,6 @@ def quat_wxyz_matrices(q: np.ndarray) -> np.ndarray:
         raise MocapError("a quaternion is zero")
     q = q / np.where((big > 1e3) | (big < 1e-3), big, 1.0)  # rescale only the far-off ones
     return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
-
-
-def up_axis(down_vector: np.ndarray, what: str) -> str:
-    """Say which file axis is up from a rest-pose vector pointing down a leg (hip -> ankle).
-
-    Returns ``"y"`` or ``"z"``; a leg along x, or pointing up, raises MocapError.
-    """
-    v = np.asarray(down_vector, dtype=float)
-    k = int(np.argmax(np.abs(v)))
-    if k == 0 or v[k] >= 0:
-        raise MocapError(
-            f"cannot tell the up axis of {what}: the rest-pose leg points along "
-            f"{'+-'[int(v[k] < 0)]}{'xyz'[k]}; supported: y-up, z-up"
-        )
-    return "xyz"[k]
 
 
 def z_up(points: np.ndarray, up: str) -> np.ndarray:
