@@ -20,7 +20,7 @@ import numpy as np
 from imitwalk.errors import MocapError, unknown_name
 from imitwalk.mocap._common import UP_AXES, check_keypoints, euler_matrices, read_lines, z_up
 from imitwalk.mocap.asf import Bone, Skeleton, read_asf
-from imitwalk.mocap.bounds import check_motion, check_rate, drop_channels
+from imitwalk.mocap.bounds import check_leg, check_motion, check_rate, drop_channels
 from imitwalk.mocap.motion import LOWER_BODY, Motion
 from imitwalk.mocap.orient import decide_up
 
@@ -185,10 +185,12 @@ def read_amc(
     guessed = up is None
     if up is None:
         feet = np.stack([found[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
-        leg = float(np.median(np.linalg.norm(found["l_knee"] - found["l_hip"], axis=1)))
-        leg += float(np.median(np.linalg.norm(found["l_ankle"] - found["l_knee"], axis=1)))
+        with np.errstate(all="ignore"):  # an absurd :units length overflows: refused below
+            leg = float(np.median(np.linalg.norm(found["l_knee"] - found["l_hip"], axis=1)))
+            leg += float(np.median(np.linalg.norm(found["l_ankle"] - found["l_knee"], axis=1)))
+        check_leg(leg, skel.source, "check the ASF :units length")
         top = found.get("head", found.get("neck", found["pelvis"]))
-        up, _ = decide_up(top, feet, leg, skel.source) if leg > 0 else ("y", "")
+        up, _ = decide_up(top, feet, leg, skel.source)
     keypoints = check_keypoints({k: z_up(v, up) for k, v in found.items()}, src, n)
     meta = {
         "skeleton": skel.source,

@@ -30,6 +30,7 @@ __all__ = [
     "LEG_RANGE_M",
     "MAX_COORD_M",
     "MAX_REACH_LEGS",
+    "check_leg",
     "check_motion",
     "check_rate",
     "drop_channels",
@@ -52,6 +53,18 @@ def check_rate(fps: float, where: str) -> float:
     if not (np.isfinite(fps) and lo <= fps <= hi):
         raise MocapError(f"{where}: frame rate {fps:.6g} fps is outside {lo:g}-{hi:g} fps")
     return float(fps)
+
+
+def check_leg(length: float, src: str, units_hint: str = "", side: str = "left") -> float:
+    """``length`` [m] of a leg if within :data:`LEG_RANGE_M`, else MocapError (with the hint)."""
+    lo, hi = LEG_RANGE_M
+    if not lo <= length <= hi:
+        hint = f"; {units_hint}" if units_hint else ""
+        raise MocapError(
+            f"{src}: the {side} leg (hip-knee-ankle) is {length:.3g} m long, outside the "
+            f"human {lo:g}-{hi:g} m{hint}"
+        )
+    return length
 
 
 def leg_lengths(keypoints: dict[str, np.ndarray]) -> dict[str, float]:
@@ -121,15 +134,9 @@ def check_motion(motion: Motion, units_hint: str = "") -> Motion:
     for name, v in k.items():
         if v.shape != (motion.n_frames, 3) or not np.all(np.isfinite(v)):
             raise MocapError(f"{src}: keypoint {name} is not a finite ({motion.n_frames}, 3) array")
-    lo, hi = LEG_RANGE_M
     legs = leg_lengths(k)
     for side, length in legs.items():
-        if not lo <= length <= hi:
-            hint = f"; {units_hint}" if units_hint else ""
-            raise MocapError(
-                f"{src}: the {'left' if side == 'l' else 'right'} leg (hip-knee-ankle) is "
-                f"{length:.3g} m long, outside the human {lo:g}-{hi:g} m{hint}"
-            )
+        check_leg(length, src, units_hint, "left" if side == "l" else "right")
     for name, v in k.items():
         if np.max(np.abs(v)) > MAX_COORD_M:
             raise MocapError(

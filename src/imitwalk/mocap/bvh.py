@@ -134,6 +134,12 @@ def read_bvh(
     pos = forward_kinematics(joints, clean, 1.0)  # (T, J, 3) file axes and units
     named = name_roles(joints, src, by_hand)
     chains, feet, pelvis, hips = _legs(joints, pos, named, src)
+    legs = [pelvis, *hips, *_knees(named, chains), *feet]
+    if not np.all(np.isfinite(pos[:, legs])):
+        t = int(np.flatnonzero(~np.all(np.isfinite(pos[:, legs]), axis=(1, 2)))[0])
+        raise MocapError(
+            f"{src}: line {rows[t]}: the legs' positions overflow (a value too large?)"
+        )
     leg = _leg_length(pos, hips, _knees(named, chains), feet[:2])
     if not leg > 0:
         raise MocapError(
@@ -206,7 +212,7 @@ def _knees(named: dict[str, int], chains) -> list[int]:
 
 def _centre(joints: list[Joint], pos: np.ndarray, pelvis: int, hips: list[int]) -> np.ndarray:
     """``(T, 3)`` mean of the upper-body joints (the pelvis if there are none)."""
-    upper = _upper_body(joints, pelvis, hips)
+    upper = [j for j in _upper_body(joints, pelvis, hips) if np.all(np.isfinite(pos[:, j]))]
     return pos[:, upper].mean(axis=1) if upper else pos[:, pelvis]
 
 

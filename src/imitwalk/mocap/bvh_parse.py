@@ -71,6 +71,10 @@ def _hierarchy(lines: list[str], src: str) -> tuple[list[Joint], int]:
             continue
         key = tok[0].upper()
         where = f"{src}: line {i + 1}"
+        if pending is not None and key != "{":
+            raise MocapError(
+                f"{where}: expected '{{' after {joints[pending]['name'] or 'End Site'}"
+            )
         if key == "MOTION":
             if stack or not joints:
                 raise MocapError(f"{where}: MOTION before the hierarchy is closed")

@@ -4,8 +4,8 @@
   frame rate within :data:`~imitwalk.mocap.bounds.FPS_RANGE`, a known ``POINT:UNITS``,
   and every frame its header promises (a truncated data section is refused).
 * A sample is invalid (NaN) if its residual is negative, it is all zero, or it is not a
-  finite number within :data:`~imitwalk.mocap.bounds.MAX_COORD_M` of the origin; the last
-  two are named in a :class:`~imitwalk.errors.MocapWarning`.
+  finite number within :data:`WILD_M` of the origin; the last two are named in a
+  :class:`~imitwalk.errors.MocapWarning`.
 * ``EVENT:TIMES`` must be ``(2, n)`` (minutes, seconds) with labels to match; events
   with a non-finite time are dropped, and a malformed EVENT group is ignored, each with
   a warning.
@@ -22,12 +22,16 @@ import numpy as np
 
 from imitwalk.errors import MocapError, MocapWarning, unknown_name
 from imitwalk.mocap._common import snap_rate
-from imitwalk.mocap.bounds import MAX_COORD_M, check_rate
+from imitwalk.mocap.bounds import check_rate
 
 __all__ = ["POINT_UNITS", "C3dTrial", "read_trial"]
 
 #: POINT:UNITS -> metres per unit.
 POINT_UNITS = {"mm": 0.001, "cm": 0.01, "m": 1.0}
+#: A sample farther than this from the origin is no coordinate at all, but a corrupt
+#: number (3e38, say) [m]; it is marked invalid. (A whole file in the wrong unit is left
+#: to the leg-length bound, which names POINT:UNITS.)
+WILD_M = 1e6
 _WIDTHS = ("LKNEEWIDTH", "RKNEEWIDTH", "LANKLEWIDTH", "RANKLEWIDTH")
 
 
@@ -152,12 +156,12 @@ def read_trial(path: str | Path) -> C3dTrial:
         raise unknown_name("C3D POINT:UNITS", units, POINT_UNITS, MocapError)
     fps = snap_rate(check_rate(rate, f"{p}: POINT:RATE"))
     xyz = pts[:, :, :3]
-    sane = np.all(np.isfinite(xyz) & (np.abs(xyz) <= MAX_COORD_M / POINT_UNITS[units]), axis=2)
+    sane = np.all(np.isfinite(xyz) & (np.abs(xyz) <= WILD_M / POINT_UNITS[units]), axis=2)
     wild = ~sane & ~(pts[:, :, 3] < 0)  # not already marked invalid by its residual
     if wild.any():
         names = sorted({labels[i] for i in np.flatnonzero(wild.any(axis=0))})
         _warn(
-            f"{p}: {np.count_nonzero(wild)} sample(s) not finite or beyond {MAX_COORD_M:g} m "
+            f"{p}: {np.count_nonzero(wild)} sample(s) not finite or beyond {WILD_M:g} m "
             f"marked invalid, in {', '.join(names)}"
         )
     bad = ~sane | ~(pts[:, :, 3] >= 0) | np.all(xyz == 0, axis=2)

@@ -146,7 +146,7 @@ def read_deepmimic(path: str | Path) -> Motion:
         raise MocapError(f"{src}: frame {t}: {channels[1 + k]} is {data[t, 1 + k]}, not finite")
     if not (np.isfinite(data[0, 0]) and data[0, 0] > 0):
         raise MocapError(f"{src}: frame 0: dt {data[0, 0]} must be a finite time > 0 s")
-    fps = check_rate(1.0 / data[0, 0], f"{src}: frame 0: dt {data[0, 0]:.6g} s")
+    fps = check_rate(1.0 / float(data[0, 0]), f"{src}: frame 0: dt {data[0, 0]:.6g} s")
     used = np.arange(data.shape[1]) > 0  # every column but the per-frame dt moves a keypoint
     kept, kept_channels, dropped = drop_channels(data, channels, used, src)
     n = len(data)

@@ -32,7 +32,7 @@ import numpy as np
 
 from imitwalk.errors import MocapError, unknown_name
 from imitwalk.mocap._common import UP_AXES, check_keypoints, z_up
-from imitwalk.mocap.bounds import check_motion
+from imitwalk.mocap.bounds import check_leg, check_motion
 from imitwalk.mocap.c3d_file import POINT_UNITS, read_trial
 from imitwalk.mocap.gaps import GapTooLong, fill_gaps
 from imitwalk.mocap.motion import KEYPOINTS, LOWER_BODY, Motion
@@ -200,9 +200,10 @@ def read_c3d(
     if up is None:
         feet = np.stack([kp[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
         leg = np.nanmedian(np.linalg.norm(kp["l_knee"] - kp["l_hip"], axis=1))
-        leg += np.nanmedian(np.linalg.norm(kp["l_ankle"] - kp["l_knee"], axis=1))
+        leg += np.nanmedian(np.linalg.norm(kp["l_ankle"] - kp["l_knee"], axis=1))  # [mm]
+        check_leg(float(leg) / 1000.0, src, "check POINT:UNITS")
         top = kp.get("neck", kp["pelvis"])
-        up, _ = decide_up(top, feet, float(leg), src) if leg > 0 else ("z", "")
+        up, _ = decide_up(top, feet, float(leg), src)
     keypoints = check_keypoints(
         {k: z_up(kp[k] / 1000.0, up) for k in KEYPOINTS if k in kp}, src, len(xyz), LOWER_BODY
     )
