@@ -319,7 +319,7 @@ BAD = {
     ),
     "every axis ambiguous": (
         _standing_tilted,
-        r"cannot tell the up axis: the head is above the feet along .* alike.*; pass --up x\|y",
+        r"cannot tell the up axis: the head is above the feet along .* alike.*; pass --up=x\|y",
     ),
 }
 
@@ -345,3 +345,21 @@ def test_bad_bvh_through_a_real_process(shared_mocap, tmp_path):
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert res.stderr.strip().count("\n") == 0 and res.stderr.startswith("error: ")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["retarget", "learn"])
+def test_cli_mocap_flags(shared_mocap, tmp_path, command):
+    """``--up``, ``--units`` and ``--joint-names`` reach the reader from both commands."""
+    from imitwalk.cli import build_parser
+    from imitwalk.commands import _motion
+
+    rig = _rig(str(shared_mocap))
+    silent = _silent(rig)
+    path = write_bvh(tmp_path / "v.bvh", rig, world=world_for("-x"), step=4, names=silent)
+    mapping = tmp_path / "names.json"
+    mapping.write_text(json.dumps({"head": silent["Head"], "neck": silent["Neck"]}))
+    argv = [command, str(path), "--up=-x", "--units", "cmu", "--joint-names", str(mapping)]
+    m = _motion(build_parser().parse_args([*argv, "--out", str(tmp_path / "o")]))
+    assert (m.meta["up_axis"], m.meta["units"]) == ("-x", "cmu") and not m.meta["up_guessed"]
+    assert m.meta["joints"]["head"] == silent["Head"] and m.meta["roles"] == "structure"
+    assert_same(m, _reference(str(shared_mocap)), 4, names=(*LOWER_BODY, "head", "neck"))

@@ -48,7 +48,7 @@ def _mocap_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--up",
         choices=("x", "y", "z", "-x", "-y", "-z"),
-        help="the file's up axis (BVH, ASF/AMC, C3D; default: detect from the motion)",
+        help="the file's up axis, e.g. --up=-x (BVH, ASF/AMC, C3D; default: from the motion)",
     )
     p.add_argument(
         "--joint-names",

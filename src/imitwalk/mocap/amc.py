@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -46,9 +47,18 @@ for _s in "lr":
     )
 
 
-def _parse_amc(lines: list[str], skel: Skeleton, src: str):
-    """The frame count ``T``, bone -> ``(T, n_dof)`` values (AMC angle unit), bone ->
+class _AmcValues(NamedTuple):
+    """An AMC's frame count ``T``, bone -> ``(T, n_dof)`` values (AMC angle unit), bone ->
     ``(T,)`` line numbers, and the AMC angle scale to degrees."""
+
+    n: int
+    values: dict[str, np.ndarray]
+    lines: dict[str, np.ndarray]
+    angle_scale: float
+
+
+def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> _AmcValues:
+    """Parse the AMC's lines against its skeleton (see :class:`_AmcValues`)."""
     rows: dict[str, list[list[float]]] = {}
     at: dict[str, list[int]] = {}
     counts: list[int] = []
@@ -90,7 +100,7 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str):
             got = len(rows.get(name, []))
             raise MocapError(f"{src}: bone {name!r} of the ASF appears in {got} of {n} frames")
     values = {k: np.array(v, dtype=float).reshape(n, -1) for k, v in rows.items()}
-    return n, values, {k: np.array(v) for k, v in at.items()}, angle_scale
+    return _AmcValues(n, values, {k: np.array(v) for k, v in at.items()}, angle_scale)
 
 
 def _forward_kinematics(skel: Skeleton, values: dict[str, np.ndarray], n: int, amc_scale: float):

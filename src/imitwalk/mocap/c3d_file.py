@@ -16,6 +16,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import c3d
 import numpy as np
@@ -108,7 +109,19 @@ def _widths(reader: c3d.Reader, src: str) -> dict[str, float]:
     return out
 
 
-def _open(p: Path):
+class _Raw(NamedTuple):
+    """What the c3d package gives: the reader, labels, frame count promised, frames read
+    (each ``(N, 4)``), point rate [Hz] and POINT:UNITS."""
+
+    reader: c3d.Reader
+    labels: tuple[str, ...]
+    expected: int
+    frames: list[np.ndarray]
+    rate: float
+    units: str
+
+
+def _open(p: Path) -> _Raw:
     with p.open("rb") as handle, warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=UserWarning, module="c3d")
         reader = c3d.Reader(handle)
@@ -127,7 +140,7 @@ def _open(p: Path):
         frames = [pts[:, :4].copy() for _, pts, _ in reader.read_frames(copy=True)]
         units_p = reader.get("POINT:UNITS")
         units = str(units_p.string_value).strip().lower() if units_p else "mm"
-        return reader, tuple(labels), expected, frames, float(reader.point_rate), units
+        return _Raw(reader, tuple(labels), expected, frames, float(reader.point_rate), units)
 
 
 def read_trial(path: str | Path) -> C3dTrial:

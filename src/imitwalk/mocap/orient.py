@@ -42,7 +42,7 @@ __all__ = [
     "decide_up",
 ]
 
-UP_FLAG = "pass --up " + "|".join(UP_AXES)
+UP_FLAG = "pass --up=" + "|".join(UP_AXES)  # "=": argparse takes "--up -x" for a flag
 UNITS_FLAG = "pass --units"
 #: Signed file axis -> unit vector.
 UP_VECTORS: dict[str, np.ndarray] = {
