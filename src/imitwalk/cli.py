@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from collections.abc import Sequence
 
 from imitwalk import commands
@@ -45,6 +46,16 @@ def _mocap_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--skeleton", help="the ASF of an AMC file (default: the .asf beside it)")
     p.add_argument("--units", help="BVH length unit: m, cm, mm, inch, cmu (default: detect)")
+    p.add_argument(
+        "--up",
+        choices=("x", "y", "z", "-x", "-y", "-z"),
+        help="the file's up axis, e.g. --up=-x (BVH, ASF/AMC, C3D; default: from the motion)",
+    )
+    p.add_argument(
+        "--joint-names",
+        metavar="FILE.json",
+        help='BVH: keypoint -> joint name, e.g. {"l_knee": "LowerLeg_L"} (default: by name/shape)',
+    )
 
 
 def _command_args(p: argparse.ArgumentParser) -> None:
@@ -191,11 +202,18 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a warning as ``warning: <message>`` (no source line)."""
+    print(f"warning: {message}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit status."""
     args = build_parser().parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            return int(args.func(args) or 0)
     except ImitwalkError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

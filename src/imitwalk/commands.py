@@ -96,7 +96,13 @@ def _motion(args: argparse.Namespace):
     from imitwalk.mocap import default_clip, load_motion
 
     path = args.file or default_clip()
-    return load_motion(path, skeleton=args.skeleton, units=getattr(args, "units", None))
+    return load_motion(
+        path,
+        skeleton=args.skeleton,
+        units=getattr(args, "units", None),
+        up=getattr(args, "up", None),
+        joint_names=getattr(args, "joint_names", None),
+    )
 
 
 def retarget(args: argparse.Namespace) -> int:
@@ -112,6 +118,7 @@ def retarget(args: argparse.Namespace) -> int:
 
     _announce_search(cfg)
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
+    progress(f"  cycles: {res.template.meta['cycles_report']}")
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = args.robot
@@ -223,7 +230,9 @@ def learn(args: argparse.Namespace) -> int:
         progress(f"learn: retargeting {motion.source}")
         rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
-        ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
+        res = do_retarget(motion, robot, rcfg, search_report, refine_report)
+        progress(f"  cycles: {res.template.meta['cycles_report']}")
+        ref = res.reference
         ref.settings["robot"] = args.robot
         ref.settings["joint_map"] = args.joint_map
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
