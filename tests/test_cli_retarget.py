@@ -42,6 +42,7 @@ def test_retarget_default_clip_json(tmp_path, capsys):
     ):
         assert key in stats
     assert stats["frames"] == 39 and stats["fps"] == 30.0 and stats["cycles_found"] >= 1
+    assert stats["cycles_used"].startswith("frames ")  # which frames, and why
     with np.load(out) as z:
         assert z["q"].shape[1] == 25 and "residual_mm" in z.files
 

@@ -89,10 +89,25 @@ def test_variants_give_the_same_keypoints(
 
 @settings(max_examples=8, deadline=None)
 @given(a=st.sampled_from(sorted(UNITS)), b=st.sampled_from(sorted(UNITS)))
-def test_units_scale_exactly(shared_mocap, a, b):
-    ma = read_bvh(shared_mocap / BVH_0706, units=a)
-    mb = read_bvh(shared_mocap / BVH_0706, units=b)
+def test_units_scale_exactly(shared_mocap, tmp_path_factory, a, b):
+    """A file written in unit ``a``, read as ``a`` and as ``b``: the keypoints scale by
+    exactly the ratio where the legs are still a human's (0.3-1.5 m); elsewhere the
+    reading is refused, naming --units."""
+    path = tmp_path_factory.mktemp("units") / "walk.bvh"
+    text = (shared_mocap / BVH_0706).read_text()
+    path.write_text(
+        rewrite_bvh(text, slice(1, 31), ["ZYX"] * 31, False, "", UNITS["cmu"] / UNITS[a])
+    )
+    ma = read_bvh(path, units=a)
     assert not ma.meta["units_guessed"] and ma.meta["units"] == a
+    leg = ma.meta["leg_length_m"] * UNITS[b] / UNITS[a]
+    if not 0.3 <= leg <= 1.5:
+        with pytest.raises(
+            MocapError, match=rf"outside the human 0.3-1.5 m; pass --units \(read as {b}\)"
+        ):
+            read_bvh(path, units=b)
+        return
+    mb = read_bvh(path, units=b)
     for key in ma.keypoints:
         np.testing.assert_allclose(
             ma.keypoints[key] / UNITS[a], mb.keypoints[key] / UNITS[b], rtol=1e-12
@@ -178,10 +193,14 @@ def test_non_numeric_value(tmp_path, lines):
     _bad(tmp_path, "\n".join(lines), r"line 261: non-numeric value")
 
 
-def test_rig_missing_a_keypoint(tmp_path, lines):
-    text = "\n".join(lines).replace("JOINT LeftToeBase", "JOINT LeftFootTip")
-    msg = _bad(tmp_path, text, r"no joint found for keypoints l_toe; joints: Hips, ")
-    assert "LeftFootTip" in msg
+def test_rig_with_an_unknown_toe_name(shared_mocap, tmp_path, lines):
+    """A toe joint no name table knows: the legs come from the skeleton's structure."""
+    path = tmp_path / "tip.bvh"
+    path.write_text("\n".join(lines).replace("JOINT LeftToeBase", "JOINT LeftFootTip"))
+    m, ref = read_bvh(path), read_bvh(shared_mocap / BVH_0704)
+    assert m.meta["roles"] == "structure" and m.meta["joints"]["l_toe"] == "LeftFootTip"
+    for key, v in ref.keypoints.items():
+        np.testing.assert_array_equal(m.keypoints[key], v, err_msg=key)
 
 
 def test_unknown_unit(shared_mocap):

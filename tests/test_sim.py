@@ -11,7 +11,7 @@ from imitwalk.cli import main
 from imitwalk.errors import ImitwalkError
 from imitwalk.metrics import tilt_deg
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, Plant, SimOptions, playback
+from imitwalk.sim import MujocoPlant, Plant, SimOptions, make_plant, playback
 from imitwalk.standing import stand_test
 
 
@@ -70,7 +70,7 @@ def test_rates_are_configurable(robot):
 
 
 def test_fall_is_detected(robot):
-    plant = MujocoPlant(robot, SimOptions(push_time=0.1, push_duration=0.3, push_force=(40, 0, 0)))
+    plant = MujocoPlant(robot, SimOptions(pushes=((0.1, 1.5, 0.0),)))
     ro = playback(plant, np.tile(robot.stand, (300, 1)))
     assert ro.fell and 0.1 < ro.fall_time < 3.0
     assert len(ro.t) < 300  # stopped at the fall
@@ -79,10 +79,30 @@ def test_fall_is_detected(robot):
 
 def test_push_changes_torso_velocity(robot):
     _, calm = _hold(robot, 0.5)
-    _, pushed = _hold(robot, 0.5, push_time=0.2, push_duration=0.05, push_force=(0, 15, 0))
+    _, pushed = _hold(robot, 0.5, pushes=((0.2, 0.0, 0.05),))
     vy = lambda ro: np.diff(ro.torso_pos[:, 1]) / ro.control_dt  # noqa: E731
     assert np.abs(vy(calm)).max() < 0.01
-    assert np.abs(vy(pushed)[20:30]).max() > 0.05
+    assert np.abs(vy(pushed)[20:30]).max() > 0.02
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "bullet"])
+def test_a_kick_changes_the_torso_velocity_by_the_drawn_amount(robot, engine):
+    """A kick of Δv changes the torso's (and the whole robot's) velocity by Δv, within 5 %."""
+    dv = np.array([0.12, -0.2])
+    opts = SimOptions(pushes=((0.2, *dv),), control_hz=1000.0)  # sampled every 1 ms
+    plant = make_plant(robot, opts, engine)
+    plant.reset()
+    velocity = []
+    for _ in range(210):
+        t0 = plant.torso_pose()[0]
+        plant.command(robot.stand)
+        plant.step()
+        velocity.append(((plant.torso_pose()[0] - t0) / plant.control_dt)[:2])
+    jumps = np.diff(velocity, axis=0)  # (209, 2) change from one 1 ms sample to the next
+    k = int(np.argmax(np.linalg.norm(jumps, axis=1)))
+    assert 195 <= k <= 205  # at 0.2 s
+    change = jumps[k]
+    assert np.allclose(change, dv, rtol=0.05, atol=0.05 * np.abs(dv).max())
 
 
 def test_gyro_noise(robot):
@@ -104,7 +124,8 @@ def test_servo_delay(robot):
         ro = playback(MujocoPlant(robot, SimOptions(servo_delay=delay)), targets)
         return int(np.argmax(np.abs(ro.q[:, j] - robot.stand[j]) > 0.02))
 
-    assert moved_at(2) - moved_at(0) == 2
+    assert moved_at(0.02) - moved_at(0.0) == 2  # two control periods
+    assert moved_at(0.005) - moved_at(0.0) in (0, 1)  # half of one: between them
 
 
 def test_friction_and_mass_and_kp_options(robot):

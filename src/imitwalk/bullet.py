@@ -23,8 +23,6 @@ of :class:`~imitwalk.simtypes.SimOptions` are applied with the same random draws
 
 from __future__ import annotations
 
-from collections import deque
-
 import numpy as np
 import pybullet as pb
 
@@ -32,7 +30,14 @@ from imitwalk.robots import Robot
 from imitwalk.robots.servos import actuator_kind, torque_limit
 from imitwalk.robots.urdf import urdf_file
 from imitwalk.servo import StablePD
-from imitwalk.simtypes import Observation, SimOptions, checked_targets, jitter_draws
+from imitwalk.simtypes import (
+    Observation,
+    ServoQueue,
+    SimOptions,
+    checked_targets,
+    jitter_draws,
+    kicks_due,
+)
 
 __all__ = ["BulletPlant"]
 
@@ -54,7 +59,7 @@ class BulletPlant:
         self.substeps = max(1, round(physics_hz / opt.control_hz))
         self.dt = 1.0 / (self.substeps * opt.control_hz)
         self.control_dt = 1.0 / opt.control_hz
-        path, u = urdf_file(robot)
+        path, u = urdf_file(robot, tuple(opt.com_shift))
         m = robot.compile()
         self.nq = m.nq
         self.client = c = pb.connect(pb.DIRECT)
@@ -123,8 +128,9 @@ class BulletPlant:
         self._torso = self._link_of_body[m.body(robot.torso).id]
         self._all_dofs = list(range(pb.getNumJoints(self.body, physicsClientId=c)))
         self._noise = np.random.default_rng(opt.seed + 7919)
-        self._queue: deque[np.ndarray] = deque()
         self._cmd = robot.stand.copy()
+        self._queue = ServoQueue(self._cmd.copy(), opt.delay_steps(1.0 / self.dt))
+        self._steps = self._kicks = 0
         self._accel = np.zeros(3)
         self._imu_now = (np.zeros(3), np.zeros(3), np.eye(3))  # set by reset() and step()
         self.time = 0.0
@@ -194,7 +200,8 @@ class BulletPlant:
         lin, ang = tw[:3].tolist(), (_rot(orn) @ tw[3:]).tolist()
         pb.resetBaseVelocity(self.body, lin, ang, physicsClientId=c)
         self._cmd = q.copy()
-        self._queue = deque([self._cmd.copy()] * opt.servo_delay)
+        self._queue = ServoQueue(self._cmd.copy(), opt.delay_steps(1.0 / self.dt))
+        self._steps = self._kicks = 0
         self._imu_now = self._site_velocity(*self._imu[:2])  # (v, ω, R) of the IMU site
         self._accel = np.zeros(3)
         self.servo.reset()
@@ -208,25 +215,27 @@ class BulletPlant:
     def step(self) -> Observation:
         c, opt = self.client, self.options
         cid = {"physicsClientId": c}
-        self._queue.append(self._cmd)
-        target = self._queue.popleft() * self._sign
+        self._queue.issue(self._steps, self._cmd)
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
         mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
-        dofs, target = self._dof + self._held, np.r_[target, self._held_target]
+        dofs = self._dof + self._held  # the held hinges' servos keep the standing posture
         mjj = mass[6 + np.array(dofs)]  # each joint's own inertia [kg m²]
         for _ in range(self.substeps):
             states = pb.getJointStates(self.body, dofs, physicsClientId=c)
             q = np.array([s[0] for s in states])
             qd = np.array([s[1] for s in states])
+            target = np.r_[self._queue.applied(self._steps) * self._sign, self._held_target]
             tau = self.servo.torque(target, q, qd, mjj).tolist()
             pb.setJointMotorControlArray(self.body, dofs, pb.TORQUE_CONTROL, forces=tau, **cid)
-            t0 = opt.push_time
-            if opt.push_duration > 0 and t0 <= self.time < t0 + opt.push_duration:
-                com = pb.getLinkState(self.body, self._torso, **cid)[0]
-                force = list(opt.push_force)  # at the torso's centre of mass, as MuJoCo's
-                pb.applyExternalForce(self.body, self._torso, force, com, pb.WORLD_FRAME, **cid)
+            if self._kicks < len(opt.pushes):
+                self._kicks, dv = kicks_due(opt.pushes, self.time, self._kicks)
+                if dv.any():  # the whole robot's horizontal velocity, as MuJoCo's kick
+                    v, w = pb.getBaseVelocity(self.body, **cid)
+                    v = [v[0] + dv[0], v[1] + dv[1], v[2]]
+                    pb.resetBaseVelocity(self.body, v, w, **cid)
             pb.stepSimulation(physicsClientId=c)
             self.time += self.dt
+            self._steps += 1
         v_before, self._imu_now = self._imu_now[0], self._site_velocity(*self._imu[:2])
         self._accel = (self._imu_now[0] - v_before) / self.control_dt
         self._check_fall()

@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from collections.abc import Sequence
 
 from imitwalk import commands, robot_commands
 from imitwalk.config import RECIPES
 from imitwalk.errors import ImitwalkError
+from imitwalk.protocol import PROTOCOLS
 from imitwalk.simtypes import ENGINES
 
 __all__ = ["build_parser", "main"]
@@ -44,6 +46,16 @@ def _mocap_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--skeleton", help="the ASF of an AMC file (default: the .asf beside it)")
     p.add_argument("--units", help="BVH length unit: m, cm, mm, inch, cmu (default: detect)")
+    p.add_argument(
+        "--up",
+        choices=("x", "y", "z", "-x", "-y", "-z"),
+        help="the file's up axis, e.g. --up=-x (BVH, ASF/AMC, C3D; default: from the motion)",
+    )
+    p.add_argument(
+        "--joint-names",
+        metavar="FILE.json",
+        help='BVH: keypoint -> joint name, e.g. {"l_knee": "LowerLeg_L"} (default: by name/shape)',
+    )
 
 
 def _command_args(p: argparse.ArgumentParser) -> None:
@@ -158,7 +170,12 @@ def build_parser() -> argparse.ArgumentParser:
     ev = sub.add_parser("evaluate", help="learned gait vs open-loop playback on perturbed robots")
     ev.add_argument("run_dir", help="a run folder written by learn")
     ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
-    ev.add_argument("--seeds", type=int, default=10, help="robots: nominal + perturbed (10)")
+    ev.add_argument("--seeds", type=int, default=None, help="robots (10; 40 with --protocol)")
+    ev.add_argument(
+        "--protocol",
+        metavar="NAME|FILE",
+        help="judge on a robustness protocol: " + ", ".join(PROTOCOLS) + ", or a protocol .json",
+    )
     ev.add_argument(
         "--scale", type=float, default=None, help="judge at this scale (default: the one reached)"
     )
@@ -190,11 +207,18 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a warning as ``warning: <message>`` (no source line)."""
+    print(f"warning: {message}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit status."""
     args = build_parser().parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            return int(args.func(args) or 0)
     except ImitwalkError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -70,7 +70,13 @@ def _motion(args: argparse.Namespace):
     from imitwalk.mocap import default_clip, load_motion
 
     path = args.file or default_clip()
-    return load_motion(path, skeleton=args.skeleton, units=getattr(args, "units", None))
+    return load_motion(
+        path,
+        skeleton=args.skeleton,
+        units=getattr(args, "units", None),
+        up=getattr(args, "up", None),
+        joint_names=getattr(args, "joint_names", None),
+    )
 
 
 def retarget(args: argparse.Namespace) -> int:
@@ -86,6 +92,7 @@ def retarget(args: argparse.Namespace) -> int:
 
     _announce_search(cfg)
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
+    progress(f"  cycles: {res.template.meta['cycles_report']}")
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = _where(args.robot)
@@ -205,7 +212,9 @@ def learn(args: argparse.Namespace) -> int:
         progress(f"learn: retargeting {motion.source}")
         rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
-        ref = do_retarget(motion, robot, rcfg, search_report, refine_report).reference
+        res = do_retarget(motion, robot, rcfg, search_report, refine_report)
+        progress(f"  cycles: {res.template.meta['cycles_report']}")
+        ref = res.reference
         ref.settings["robot"] = _where(args.robot)
         ref.settings["joint_map"] = _where(args.joint_map)
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
@@ -231,6 +240,7 @@ def learn(args: argparse.Namespace) -> int:
 
 
 def evaluate(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError
     from imitwalk.evaluate import check_gain, evaluate_run
     from imitwalk.robustness import robustness_grid
     from imitwalk.runs import RunDir
@@ -241,8 +251,13 @@ def evaluate(args: argparse.Namespace) -> int:
     if args.robot is None:
         args.robot, args.joint_map = _run_robot(rd, cfg)
     learned_on = cfg.get("learn", {}).get("engine", "mujoco")
+    if args.protocol is not None:
+        if args.engine is not None:
+            raise ConfigError("--engine: a protocol names its own engine (e.g. --protocol bullet)")
+        return _evaluate_protocol(args, rd, robot_from(args))
     args.engine = args.engine or learned_on
     robot = robot_from(args)
+    args.seeds = 10 if args.seeds is None else args.seeds
     common = {"workers": args.workers, "scale": args.scale, "engine": args.engine}
     common["gain"] = args.gain
     if args.perturb:
@@ -267,6 +282,38 @@ def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
     )
     name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
     return name or "hoap2", settings.get("joint_map")
+
+
+def _evaluate_protocol(args: argparse.Namespace, rd, robot) -> int:
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge import judge_protocol
+    from imitwalk.protocol import load_protocol
+
+    protocol = load_protocol(args.protocol)
+    if args.perturb:
+        raise ConfigError("--protocol and --perturb are two evaluations; give one")
+    seeds = 40 if args.seeds is None else args.seeds
+    if seeds < 1 or not args.seconds > 0:
+        raise ConfigError(f"--seeds {seeds} --seconds {args.seconds:g}: expected >= 1 and > 0")
+    progress(
+        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
+        f"{seeds} robots x {args.seconds:g} s"
+    )
+    out = judge_protocol(
+        rd.path, robot, protocol, seeds, args.seconds, scale=args.scale,
+        workers=args.workers, gain=args.gain,
+    )  # fmt: skip
+    for name, side in out["controllers"].items():
+        lo, hi = side["survival_ci95"]
+        progress(
+            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
+            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+        )
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
+    emit(out, args.json)
+    return 0
 
 
 def _result_name(kind: str, args: argparse.Namespace, learned_on: str) -> str:

@@ -13,6 +13,7 @@ __all__ = [
     "ConfigError",
     "ImitwalkError",
     "MocapError",
+    "MocapWarning",
     "RetargetError",
     "RobotError",
     "RunError",
@@ -26,6 +27,10 @@ class ImitwalkError(Exception):
 
 class MocapError(ImitwalkError):
     """A motion-capture file cannot be read or holds no usable motion."""
+
+
+class MocapWarning(UserWarning):
+    """A mocap file was read, but something in it was dropped or repaired (named in the message)."""
 
 
 class RobotError(ImitwalkError):

@@ -4,7 +4,8 @@ Cells (each on top of the evaluation robots, seed 0 nominal and the rest perturb
 floor friction × 0.5, 0.75, 1.25, 1.5; every mass × 0.8, 0.9, 1.1, 1.2; every servo's
 stiffness × 0.9, 1.1; gyro noise;
 a servo delay of one and of two control periods; a ±3° slope along the walk; and a
-lateral push on the torso in the middle of the walk, in two sizes.
+lateral kick in the middle of the walk, in two sizes (impulses of 1 and 2 N·s, as
+velocity changes of the robot's mass).
 """
 
 from __future__ import annotations
@@ -20,13 +21,13 @@ from imitwalk.sim import SimOptions
 
 __all__ = ["CELLS", "robustness_grid"]
 
-#: Push size: a force [N] on the torso for 0.1 s (impulses of 1 and 2 N·s).
-PUSHES = {"push_small": 10.0, "push_large": 20.0}
+#: Push size: an impulse [N s] on the whole robot (a kick of impulse / mass [m/s]).
+PUSHES = {"push_small": 1.0, "push_large": 2.0}
 #: Gyro noise standard deviation in its cell [rad/s].
 GYRO_NOISE = 0.03
 
 
-def _cells(seconds: float) -> dict[str, SimOptions]:
+def _cells(seconds: float, mass: float = 1.0) -> dict[str, SimOptions]:
     base = SimOptions()
     cells = {"nominal": base}
     for f in (0.5, 0.75, 1.25, 1.5):
@@ -36,14 +37,13 @@ def _cells(seconds: float) -> dict[str, SimOptions]:
     for k in (0.9, 1.1):
         cells[f"servo_kp_x{k:g}"] = replace(base, kp_scale=k)
     cells["gyro_noise"] = replace(base, gyro_noise=GYRO_NOISE)
-    cells["delay_1"] = replace(base, servo_delay=1)
-    cells["delay_2"] = replace(base, servo_delay=2)
+    dt = 1.0 / base.control_hz
+    cells["delay_1"] = replace(base, servo_delay=dt)
+    cells["delay_2"] = replace(base, servo_delay=2 * dt)
     cells["slope_up_3deg"] = replace(base, slope_deg=3.0)
     cells["slope_down_3deg"] = replace(base, slope_deg=-3.0)
-    for name, force in PUSHES.items():
-        cells[name] = replace(
-            base, push_time=seconds / 2, push_duration=0.1, push_force=(0.0, force, 0.0)
-        )
+    for name, impulse in PUSHES.items():
+        cells[name] = replace(base, pushes=((seconds / 2, 0.0, impulse / mass),))
     return cells
 
 
@@ -72,7 +72,7 @@ def robustness_grid(
         each side has ``survived`` (of ``seeds``) and ``distance_m`` (mean), and totals
         count the cells in which every seed survived.
     """
-    grid = _cells(seconds)
+    grid = _cells(seconds, robot.total_mass)
     names = cells or tuple(grid)
     out: dict = {"seconds": seconds, "seeds": seeds, "scale": scale, "engine": engine}
     metrics = RunDir(run_dir).read_json("metrics.json")

@@ -9,13 +9,13 @@ returns a typed :class:`Rollout`; :func:`playback` plays a joint trajectory.
 
 Robustness options (all default off) live in :class:`SimOptions`: gyro and
 accelerometer noise (added in NumPy, MuJoCo does not simulate sensor noise), servo
-delay, friction / mass / servo-stiffness scaling and per-part jitter, a ground
-slope (gravity tilted about y), a timed push on the torso and an initial twist.
+delay, friction / mass / servo-stiffness scaling and per-part jitter, a shifted torso
+centre of mass, a ground slope (gravity tilted about y), velocity kicks (pushes) and
+an initial twist.
 """
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
@@ -28,9 +28,11 @@ from imitwalk.simtypes import (
     ENGINES,
     Observation,
     Rollout,
+    ServoQueue,
     SimOptions,
     checked_targets,
     jitter_draws,
+    kicks_due,
 )
 
 __all__ = [
@@ -84,6 +86,7 @@ class MujocoPlant:
         m.geom_friction[:, 0] *= opt.friction_scale
         m.body_mass[:] *= scale
         m.body_inertia[:] *= scale[:, None]
+        m.body_ipos[m.body(robot.torso).id] += np.asarray(opt.com_shift, dtype=float)
         self._jid = np.array([m.joint(j).id for j in robot.mj_joints])
         self._qadr = m.jnt_qposadr[self._jid]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
@@ -100,9 +103,13 @@ class MujocoPlant:
         self._accel = sadr(robot.accelerometer) if robot.accelerometer else None
         self._ff = [[sadr(n) for n in robot.foot_force[s]] for s in ("l", "r")]
         self._torso = m.body(robot.torso).id
+        free = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+        self._base_dof = int(m.jnt_dofadr[free[0]]) if free else None
         self._noise = np.random.default_rng(opt.seed + 7919)
         self.data = mujoco.MjData(m)
-        self._queue: deque[np.ndarray] = deque()
+        self._delay = opt.delay_steps()
+        self._queue = ServoQueue(robot.stand.copy(), self._delay)
+        self._steps = self._kicks = 0
         self._cmd = robot.stand.copy()
         self.fell = False
         self.fall_time: float | None = None
@@ -122,7 +129,8 @@ class MujocoPlant:
             d.qpos[2] -= low - 1e-4
         d.qvel[:6] = self.options.init_twist
         self._cmd = (r.stand if q is None else q).copy()
-        self._queue = deque([self._cmd.copy()] * self.options.servo_delay)
+        self._queue = ServoQueue(self._cmd.copy(), self._delay)
+        self._steps = self._kicks = 0
         d.ctrl[self._act] = self._cmd * self._sign
         mujoco.mj_forward(m, d)
         self.fell, self.fall_time = False, None
@@ -133,14 +141,15 @@ class MujocoPlant:
 
     def step(self) -> Observation:
         m, d, opt = self.model, self.data, self.options
-        self._queue.append(self._cmd)
-        applied = self._queue.popleft()
-        d.ctrl[self._act] = applied * self._sign
+        self._queue.issue(self._steps, self._cmd)
         for _ in range(opt.substeps):
-            t0 = opt.push_time
-            on = opt.push_duration > 0 and t0 <= d.time < t0 + opt.push_duration
-            d.xfrc_applied[self._torso, :3] = opt.push_force if on else 0.0
+            d.ctrl[self._act] = self._queue.applied(self._steps) * self._sign
+            if self._kicks < len(opt.pushes) and self._base_dof is not None:
+                self._kicks, dv = kicks_due(opt.pushes, d.time, self._kicks)
+                b = self._base_dof  # the free base's linear velocity, world frame
+                d.qvel[b : b + 2] += dv
             mujoco.mj_step(m, d)
+            self._steps += 1
         self._check_fall()
         return self.observe()
 

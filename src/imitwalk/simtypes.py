@@ -5,6 +5,7 @@ Plain data (NumPy only), so code that judges or plots runs needs no MuJoCo.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -13,9 +14,11 @@ __all__ = [
     "ENGINES",
     "Observation",
     "Rollout",
+    "ServoQueue",
     "SimOptions",
     "checked_targets",
     "jitter_draws",
+    "kicks_due",
 ]
 
 #: Physics engines a plant can run on: MuJoCo (the default everywhere) and Bullet
@@ -32,7 +35,7 @@ class SimOptions:
         control_hz: rate at which joint targets are commanded [Hz].
         gyro_noise: gyro noise standard deviation [rad/s].
         accel_noise: accelerometer noise standard deviation [m/s²].
-        servo_delay: commands reach the servos this many control periods late.
+        servo_delay: commands reach the servos this late [s] (rounded to physics steps).
         friction: if set, the sliding friction coefficient of every contact.
         friction_scale: multiplies every sliding friction coefficient.
         mass_scale: multiplies every body mass and inertia.
@@ -41,8 +44,11 @@ class SimOptions:
         kp_jitter_joints: if set, only these joints' servos take their jitter (the draws
             are the same, so the other joints are as with no jitter at all).
         slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
-        push_time, push_duration: when [s] and how long [s] the torso is pushed.
-        push_force: ``(3,)`` world-frame force on the torso during the push [N].
+        com_shift: ``(3,)`` the torso's centre of mass moved by this much in its own frame [m].
+        pushes: velocity kicks ``(t [s], Δv_x, Δv_y [m/s])``, in time order: at the first
+            physics step at or after ``t`` the whole robot's horizontal velocity changes by
+            ``Δv`` (world frame), an impulse of mass × Δv, so a kick means the same on a
+            light and a heavy robot (:mod:`imitwalk.protocol` draws them).
         init_twist: ``(6,)`` initial base velocity, linear [m/s] then angular [rad/s].
         seed: seeds sensor noise and jitter.
         fall_height: a fall is the torso under this fraction of its standing height ...
@@ -53,7 +59,7 @@ class SimOptions:
     control_hz: float = 100.0
     gyro_noise: float = 0.0
     accel_noise: float = 0.0
-    servo_delay: int = 0
+    servo_delay: float = 0.0
     friction: float | None = None
     friction_scale: float = 1.0
     mass_scale: float = 1.0
@@ -62,9 +68,8 @@ class SimOptions:
     kp_jitter: float = 0.0
     kp_jitter_joints: tuple[str, ...] = ()
     slope_deg: float = 0.0
-    push_time: float = 0.0
-    push_duration: float = 0.0
-    push_force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    com_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    pushes: tuple[tuple[float, float, float], ...] = ()
     init_twist: tuple[float, ...] = (0.0,) * 6
     seed: int = 0
     fall_height: float = 0.5
@@ -74,6 +79,42 @@ class SimOptions:
     def substeps(self) -> int:
         """Physics steps per control period."""
         return max(1, round(self.physics_hz / self.control_hz))
+
+    def delay_steps(self, physics_hz: float | None = None) -> int:
+        """``servo_delay`` in physics steps (of ``physics_hz``, default this rate)."""
+        return max(0, round(self.servo_delay * (physics_hz or self.physics_hz)))
+
+
+class ServoQueue:
+    """Joint commands on their way to the servos, ``delay`` physics steps late.
+
+    :meth:`issue` a command at a physics step; :meth:`applied` says which command the
+    servos hold at a physics step (the last one issued at least ``delay`` steps before).
+    """
+
+    def __init__(self, first: np.ndarray, delay: int):
+        self.delay, self._now = delay, first
+        self._pending: deque[tuple[int, np.ndarray]] = deque()
+
+    def issue(self, step: int, command: np.ndarray) -> None:
+        """Send ``command`` at physics step ``step``."""
+        self._pending.append((step + self.delay, command))
+
+    def applied(self, step: int) -> np.ndarray:
+        """The command the servos hold at physics step ``step``."""
+        while self._pending and self._pending[0][0] <= step:
+            self._now = self._pending.popleft()[1]
+        return self._now
+
+
+def kicks_due(pushes, t: float, done: int) -> tuple[int, np.ndarray]:
+    """The velocity kicks of ``pushes`` due by time ``t`` [s] that were not applied yet
+    (``done`` of them were): how many are done now, and their summed ``(2,)`` Δv [m/s]."""
+    dv = np.zeros(2)
+    while done < len(pushes) and pushes[done][0] <= t + 1e-9:
+        dv += np.asarray(pushes[done][1:3], dtype=float)
+        done += 1
+    return done, dv
 
 
 def checked_targets(targets, n: int) -> np.ndarray:

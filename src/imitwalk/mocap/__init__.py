@@ -49,7 +49,10 @@ DEFAULT_CLIP = "humanoid3d_walk.txt"
 def _skeleton_for(amc: Path, skeleton: str | Path | None) -> Path:
     if skeleton is not None:
         return Path(skeleton)
-    found = sorted(p for p in amc.parent.iterdir() if p.suffix.lower() == ".asf")
+    try:
+        found = sorted(p for p in amc.parent.iterdir() if p.suffix.lower() == ".asf")
+    except OSError as exc:
+        raise MocapError(f"{amc}: cannot list its folder for the ASF: {exc}") from None
     if len(found) != 1:
         which = ", ".join(p.name for p in found) if found else "none"
         raise MocapError(
@@ -59,7 +62,12 @@ def _skeleton_for(amc: Path, skeleton: str | Path | None) -> Path:
 
 
 def load_motion(
-    path: str | Path, *, skeleton: str | Path | None = None, units: str | None = None
+    path: str | Path,
+    *,
+    skeleton: str | Path | None = None,
+    units: str | None = None,
+    up: str | None = None,
+    joint_names: str | Path | dict[str, str] | None = None,
 ) -> Motion:
     """Read a motion-capture file, choosing the reader by extension.
 
@@ -68,9 +76,13 @@ def load_motion(
         skeleton: the ``.asf`` of an ``.amc`` (default: the single ``.asf`` beside it).
         units: BVH length unit (``"m"``, ``"cm"``, ``"mm"``, ``"inch"``, ``"cmu"``);
             None guesses it. Other formats state their units and reject this option.
+        up: the file's up axis (``x y z -x -y -z``) for BVH, ASF/AMC and C3D; None
+            tells it from the motion. DeepMimic is y-up by definition.
+        joint_names: BVH only: a JSON file (or dict) keypoint -> joint name.
 
     Returns:
-        the :class:`Motion` (keypoints ``(T, 3)`` [m], z up, world frame).
+        the :class:`Motion` (keypoints ``(T, 3)`` [m], z up, world frame), within the
+        bounds of :mod:`imitwalk.mocap.bounds`.
 
     Raises:
         MocapError: missing file, unknown extension, or a file that cannot be read.
@@ -86,12 +98,16 @@ def load_motion(
         raise MocapError(f"mocap file not found: {p}")
     if units is not None and kind != "bvh":
         raise MocapError(f"units= applies to BVH files only; {p.name} is {kind}")
+    if joint_names is not None and kind != "bvh":
+        raise MocapError(f"joint_names= applies to BVH files only; {p.name} is {kind}")
+    if up is not None and kind == "deepmimic":
+        raise MocapError(f"up= does not apply to DeepMimic files (y-up by definition): {p.name}")
     if kind == "bvh":
-        return read_bvh(p, units=units)
+        return read_bvh(p, units=units, up=up, joint_names=joint_names)
     if kind == "amc":
-        return read_amc(p, _skeleton_for(p, skeleton))
+        return read_amc(p, _skeleton_for(p, skeleton), up=up)
     if kind == "c3d":
-        return read_c3d(p)
+        return read_c3d(p, up=up)
     return read_deepmimic(p)
 
 

@@ -1,28 +1,31 @@
-"""Acclaim ASF (skeleton) + AMC (motion) reader, the CMU database's own format.
+"""Acclaim AMC motion reader, with its ASF skeleton (:mod:`imitwalk.mocap.asf`).
 
-* ASF ``:units``: ``length L`` means 1 unit = 1/L inch (CMU: L = 0.45, 1 unit = 5.64 cm);
-  ``angle deg|rad`` applies to the ``axis``/``orientation`` values.
 * Forward kinematics per the Acclaim spec: each bone has a fixed axis rotation ``C``
   (``axis ax ay az ORDER``, world-aligned) and per-frame DOF rotation ``M`` (the DOFs in
   the listed order, first listed applied first); its world rotation is
   ``G = G_parent @ C @ M @ C^-1`` (i.e. ``L = C^-1 M C`` in the spec's row-vector form),
   and it ends at ``start + length * G @ direction``.
 * AMC: ``:FULLY-SPECIFIED``, ``:DEGREES`` (or ``:RADIANS``), 120 Hz unless told.
-* The ASF axes are y-up: mapped to z-up by (x, y, z) -> (x, -z, y).
+* The up axis is told by the animated skeleton (head above the feet,
+  :func:`~imitwalk.mocap.orient.decide_up`; CMU's ASF axes are y-up) unless ``up=``
+  is given, and mapped to z up (:data:`~imitwalk.mocap._common.UP_TO_Z_UP`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
-from imitwalk.errors import MocapError
-from imitwalk.mocap._common import check_keypoints, euler_matrices, read_lines, up_axis, z_up
-from imitwalk.mocap.motion import Motion
+from imitwalk.errors import MocapError, unknown_name
+from imitwalk.mocap._common import UP_AXES, check_keypoints, euler_matrices, read_lines, z_up
+from imitwalk.mocap.asf import Bone, Skeleton, read_asf
+from imitwalk.mocap.bounds import check_leg, check_motion, check_rate, drop_channels
+from imitwalk.mocap.motion import LOWER_BODY, Motion
+from imitwalk.mocap.orient import decide_up
 
-__all__ = ["read_amc", "read_asf"]
+__all__ = ["Bone", "Skeleton", "read_amc", "read_asf"]
 
 # Keypoint -> (bone, "start"|"end") alternatives, CMU ASF bone names.
 _KEYPOINT_BONES: dict[str, tuple[tuple[str, str], ...]] = {
@@ -44,109 +47,20 @@ for _s in "lr":
     )
 
 
-@dataclass
-class Bone:
-    """One ASF bone. ``direction`` is a world-frame unit vector, ``length`` in ASF units."""
+class _AmcValues(NamedTuple):
+    """An AMC's frame count ``T``, bone -> ``(T, n_dof)`` values (AMC angle unit), bone ->
+    ``(T,)`` line numbers, and the AMC angle scale to degrees."""
 
-    name: str
-    direction: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    length: float = 0.0
-    axis: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) angles, ASF angle unit
-    axis_order: str = "xyz"
-    dof: tuple[str, ...] = ()
-    parent: str | None = None
+    n: int
+    values: dict[str, np.ndarray]
+    lines: dict[str, np.ndarray]
+    angle_scale: float
 
 
-@dataclass
-class Skeleton:
-    """A parsed ASF: bones in hierarchy order (parents first; ``bones[0]`` is the root)."""
-
-    bones: dict[str, Bone]
-    metres_per_unit: float
-    angle_scale: float  # ASF angle unit -> degrees
-    root_position: np.ndarray
-    source: str
-
-
-def read_asf(path: str | Path) -> Skeleton:
-    """Parse an ASF skeleton file."""
-    src = str(path)
-    lines = [ln.split("#", 1)[0].strip() for ln in read_lines(path)]
-    root = Bone("root", dof=())
-    bones: dict[str, Bone] = {}
-    children: dict[str, list[str]] = {}
-    length_unit, angle_scale = 1.0, 1.0
-    root_pos = np.zeros(3)
-    section, bone = "", None
-    for i, ln in enumerate(lines):
-        tok = ln.split()
-        if not tok:
-            continue
-        where = f"{src}: line {i + 1}"
-        try:
-            if tok[0].startswith(":"):
-                section = tok[0][1:].lower()
-            elif section == "units" and tok[0] == "length":
-                length_unit = float(tok[1])
-            elif section == "units" and tok[0] == "angle":
-                angle_scale = 1.0 if tok[1].lower().startswith("deg") else float(np.degrees(1.0))
-            elif section == "root" and tok[0] == "order":
-                root.dof = tuple(t.lower() for t in tok[1:])
-            elif section == "root" and tok[0] == "axis":
-                root.axis_order = tok[1].lower()
-            elif section == "root" and tok[0] == "position":
-                root_pos = np.array([float(v) for v in tok[1:4]])
-            elif section == "root" and tok[0] == "orientation":
-                root.axis = np.array([float(v) for v in tok[1:4]])
-            elif section == "bonedata":
-                bone = _bone_line(tok, bone, bones)
-            elif section == "hierarchy" and tok[0] not in ("begin", "end"):
-                children.setdefault(tok[0], []).extend(tok[1:])
-        except (ValueError, IndexError):
-            raise MocapError(f"{where}: malformed ASF line {ln[:40]!r}") from None
-    if not bones or not children:
-        raise MocapError(f"{src}: no :bonedata or :hierarchy section (not an ASF file?)")
-    if length_unit <= 0:
-        raise MocapError(f"{src}: bad :units length {length_unit}")
-    ordered: dict[str, Bone] = {"root": root}
-    queue = ["root"]
-    while queue:
-        parent = queue.pop(0)
-        for child in children.get(parent, []):
-            if child not in bones:
-                raise MocapError(f"{src}: :hierarchy names unknown bone {child!r}")
-            bones[child].parent = parent
-            ordered[child] = bones[child]
-            queue.append(child)
-    return Skeleton(ordered, 0.0254 / length_unit, angle_scale, root_pos, src)
-
-
-def _bone_line(tok: list[str], bone: Bone | None, bones: dict[str, Bone]) -> Bone | None:
-    key = tok[0].lower()
-    if key == "begin":
-        return Bone("")
-    if bone is None:
-        return None
-    if key == "end":
-        bones[bone.name] = bone
-        return None
-    if key == "name":
-        bone.name = tok[1]
-    elif key == "direction":
-        bone.direction = np.array([float(v) for v in tok[1:4]])
-    elif key == "length":
-        bone.length = float(tok[1])
-    elif key == "axis":
-        bone.axis = np.array([float(v) for v in tok[1:4]])
-        bone.axis_order = tok[4].lower() if len(tok) > 4 else "xyz"
-    elif key == "dof":
-        bone.dof = tuple(t.lower() for t in tok[1:])
-    return bone
-
-
-def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> tuple[dict[str, np.ndarray], float]:
-    """Return bone -> ``(T, n_dof)`` values (AMC angle unit) and the AMC angle scale to degrees."""
+def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> _AmcValues:
+    """Parse the AMC's lines against its skeleton (see :class:`_AmcValues`)."""
     rows: dict[str, list[list[float]]] = {}
+    at: dict[str, list[int]] = {}
     counts: list[int] = []
     angle_scale = 1.0
     for i, ln in enumerate(lines):
@@ -174,7 +88,9 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> tuple[dict[str, np
             values = [float(v) for v in tok[1:]]
         except ValueError:
             raise MocapError(f"{src}: line {i + 1}: non-numeric value for bone {name!r}") from None
-        rows.setdefault(name, []).append(values)
+        if ndof:
+            rows.setdefault(name, []).append(values)
+            at.setdefault(name, []).append(i + 1)
         counts[-1] += 1
     if not counts:
         raise MocapError(f"{src}: no frames (not an AMC file?)")
@@ -183,24 +99,13 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> tuple[dict[str, np
         if bone.dof and len(rows.get(name, [])) != n:
             got = len(rows.get(name, []))
             raise MocapError(f"{src}: bone {name!r} of the ASF appears in {got} of {n} frames")
-    return {k: np.array(v) for k, v in rows.items()}, angle_scale
+    values = {k: np.array(v, dtype=float).reshape(n, -1) for k, v in rows.items()}
+    return _AmcValues(n, values, {k: np.array(v) for k, v in at.items()}, angle_scale)
 
 
-def read_amc(path: str | Path, skeleton: str | Path, *, fps: float = 120.0) -> Motion:
-    """Read an AMC motion with its ASF skeleton.
-
-    Args:
-        path: the ``.amc`` file; skeleton: its ``.asf`` file; fps: frame rate [Hz].
-
-    Returns:
-        a :class:`Motion`: ``data`` ``(T, D)`` AMC values (root translation in ASF units,
-        angles as in the file), ``keypoints`` ``(T, 3)`` [m] z up, ``meta["segments_m"]``
-        bone lengths [m], ``meta["skeleton"]`` the ASF path.
-    """
-    src = str(path)
-    skel = read_asf(skeleton)
-    values, amc_scale = _parse_amc(read_lines(path), skel, src)
-    n = len(next(iter(values.values())))
+def _forward_kinematics(skel: Skeleton, values: dict[str, np.ndarray], n: int, amc_scale: float):
+    """Start and end ``(T, 3)`` of each bone in ASF axes [m] (``amc_scale``: AMC angle
+    unit -> degrees)."""
     scale = skel.metres_per_unit
     start: dict[str, np.ndarray] = {}
     end: dict[str, np.ndarray] = {}
@@ -209,15 +114,9 @@ def read_amc(path: str | Path, skeleton: str | Path, *, fps: float = 120.0) -> M
         vals = values.get(name, np.zeros((n, 0)))
         rot_axes = "".join(d[1] for d in bone.dof if d[0] == "r")
         rot_cols = [k for k, d in enumerate(bone.dof) if d[0] == "r"]
-        if len(rot_cols) + sum(d in ("tx", "ty", "tz") for d in bone.dof) != len(bone.dof):
-            raise MocapError(f"{skel.source}: bone {name!r} has unsupported dof {bone.dof}")
-        if name != "root" and len(rot_cols) != len(bone.dof):
-            raise MocapError(f"{skel.source}: bone {name!r} has translation dof {bone.dof}")
         m = euler_matrices(rot_axes, vals[:, rot_cols] * amc_scale, intrinsic=False)
-        c = euler_matrices(bone.axis_order, bone.axis[None, :] * skel.angle_scale, intrinsic=False)[
-            0
-        ]
-        local = c @ m @ c.T  # (T, 3, 3)
+        c = euler_matrices(bone.axis_order, bone.axis[None, :] * skel.angle_scale, intrinsic=False)
+        local = c[0] @ m @ c[0].T  # (T, 3, 3)
         if bone.parent is None:
             pos = np.broadcast_to(skel.root_position * scale, (n, 3)).copy()
             for k, d in enumerate(bone.dof):
@@ -229,23 +128,87 @@ def read_amc(path: str | Path, skeleton: str | Path, *, fps: float = 120.0) -> M
             start[name] = end[bone.parent]
             offset = bone.length * scale * bone.direction
             end[name] = start[name] + np.einsum("tij,j->ti", rot[name], offset)
-    found: dict[str, np.ndarray] = {}
+    return start, end
+
+
+def _used_bones(skel: Skeleton, sources: dict[str, tuple[str, str]]) -> set[str]:
+    """Bones whose DOFs move a keypoint: the ancestors of each keypoint's bone, and the
+    bone itself when the keypoint is its end."""
+    used = {"root"}
+    for bone, where in sources.values():
+        if where == "end":
+            used.add(bone)
+        at = skel.bones[bone].parent
+        while at is not None and at not in used:
+            used.add(at)
+            at = skel.bones[at].parent
+    return used
+
+
+def read_amc(
+    path: str | Path, skeleton: str | Path, *, fps: float = 120.0, up: str | None = None
+) -> Motion:
+    """Read an AMC motion with its ASF skeleton.
+
+    Args:
+        path: the ``.amc`` file; skeleton: its ``.asf`` file; fps: frame rate [Hz];
+        up: the ASF's up axis (``x y z -x -y -z``); None tells it from the motion.
+
+    Returns:
+        a :class:`Motion`: ``data`` ``(T, D)`` AMC values (root translation in ASF units,
+        angles as in the file), ``keypoints`` ``(T, 3)`` [m] z up, ``meta["segments_m"]``
+        bone lengths [m], ``meta["skeleton"]`` the ASF path.
+    """
+    src = str(path)
+    if up is not None and up not in UP_AXES:
+        raise unknown_name("up axis", up, UP_AXES, MocapError)
+    fps = check_rate(fps, src)
+    skel = read_asf(skeleton)
+    n, values, at, amc_scale = _parse_amc(read_lines(path), skel, src)
+    sources = {}
     for key, options in _KEYPOINT_BONES.items():
-        for bone_name, where in options:
-            if bone_name in skel.bones:
-                found[key] = (start if where == "start" else end)[bone_name]
-                break
-    leg = [b for b in ("lfemur", "ltibia") if b in skel.bones]
-    if len(leg) < 2:
-        raise MocapError(f"{skel.source}: no lfemur/ltibia bones; bones: {', '.join(skel.bones)}")
-    up = up_axis(sum(skel.bones[b].direction * skel.bones[b].length for b in leg), skel.source)
-    keypoints = check_keypoints({k: z_up(v, up) for k, v in found.items()}, src, n)
+        hit = next(((b, w) for b, w in options if b in skel.bones), None)
+        if hit is not None:
+            sources[key] = hit
+    missing = [k for k in LOWER_BODY if k not in sources]
+    if missing:
+        raise MocapError(
+            f"{skel.source}: no bones for keypoints {', '.join(missing)}; "
+            f"bones: {', '.join(skel.bones)}"
+        )
     channels = tuple(f"{b}.{d}" for b in skel.bones if b in values for d in skel.bones[b].dof)
-    data = np.concatenate([values[b] for b in skel.bones if b in values], axis=1)
+    data = np.concatenate([np.zeros((n, 0))] + [values[b] for b in skel.bones if b in values], 1)
+    used_bones = _used_bones(skel, sources)
+    used = np.array([c.split(".", 1)[0] in used_bones for c in channels], dtype=bool)
+    for b in skel.bones:
+        if b in used_bones and b in values and not np.all(np.isfinite(values[b])):
+            t, k = (int(i[0]) for i in np.nonzero(~np.isfinite(values[b])))
+            raise MocapError(
+                f"{src}: line {at[b][t]}: {b}.{skel.bones[b].dof[k]} is {values[b][t, k]}, "
+                "and it moves a keypoint"
+            )
+    data, channels, dropped = drop_channels(data, channels, used, src)
+    clean = {b: np.where(np.isfinite(v), v, 0.0) for b, v in values.items()}
+    scale = skel.metres_per_unit
+    start, end = _forward_kinematics(skel, clean, n, amc_scale)
+    found = {k: (start if w == "start" else end)[b] for k, (b, w) in sources.items()}
+    guessed = up is None
+    if up is None:
+        feet = np.stack([found[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
+        with np.errstate(all="ignore"):  # an absurd :units length overflows: refused below
+            leg = float(np.median(np.linalg.norm(found["l_knee"] - found["l_hip"], axis=1)))
+            leg += float(np.median(np.linalg.norm(found["l_ankle"] - found["l_knee"], axis=1)))
+        check_leg(leg, skel.source, "check the ASF :units length")
+        top = found.get("head", found.get("neck", found["pelvis"]))
+        up, _ = decide_up(top, feet, leg, skel.source)
+    keypoints = check_keypoints({k: z_up(v, up) for k, v in found.items()}, src, n)
     meta = {
         "skeleton": skel.source,
         "metres_per_unit": scale,
         "up_axis": up,
+        "up_guessed": guessed,
         "segments_m": {b.name: b.length * scale for b in skel.bones.values() if b.parent},
+        "dropped_channels": dropped,
     }
-    return Motion(float(fps), channels, data, keypoints, src, "amc", meta=meta)
+    motion = Motion(fps, channels, data, keypoints, src, "amc", meta=meta)
+    return check_motion(motion, "check the ASF :units length")

@@ -1,300 +1,227 @@
 """BVH reader: hierarchy + motion channels -> forward kinematics -> keypoints.
 
-* Rotation channels in any order per joint, applied as listed (intrinsic: channels
-  ``Zrotation Yrotation Xrotation`` give ``R = Rz @ Ry @ Rx``), degrees.
-* Position channels on any joint replace the matching component of its OFFSET (the
-  Blender convention; the root's position channels are its position).
-* Units: ``"m"``, ``"cm"``, ``"mm"``, ``"inch"`` or ``"cmu"`` (the CMU ASF unit,
-  1/0.45 inch = 5.64 cm); ``units=None`` picks the one that makes the rest-pose
-  standing hip height (hip joint to the lowest point of the leg) closest to 0.9 m.
-* Up axis: told by the rest-pose leg (hip -> ankle points down); y-up files are mapped
-  to z-up by (x, y, z) -> (x, -z, y).
-* Frame 0 of a CMU/cgspeed conversion is a T-pose added by the converter (integer
-  rotation channels in frame 0 only); it is dropped and ``meta["skipped_frames"] == 1``.
+The posture is read from the motion, not from the rest pose: forward kinematics runs
+over the frames first (:mod:`imitwalk.mocap.skeleton`: 0, 3 or 6 channels on any
+joint, in any order), and the animated skeleton then tells
+
+* which joints are the legs (:mod:`imitwalk.mocap.roles`: by name across CMU,
+  Mixamo, LAFAN1, ``*_L``/``l_*`` rigs; by structure where names are silent; by hand
+  with ``joint_names=``);
+* the up axis, the direction of travel and the units (:mod:`imitwalk.mocap.orient`);
+  ``up=`` and ``units=`` override the guesses.
+
+Units: ``"m"``, ``"cm"``, ``"mm"``, ``"inch"`` or ``"cmu"`` (the CMU ASF unit, 1/0.45
+inch = 5.64 cm). The file's up axis is mapped to z up (:data:`~imitwalk.mocap._common.
+UP_TO_Z_UP`; y-up by (x, y, z) -> (x, -z, y)). Frame 0 of a CMU/cgspeed conversion is a
+T-pose added by the converter (integer rotation channels in frame 0 only); it is dropped
+and ``meta["skipped_frames"] == 1``.
 """
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from imitwalk.errors import MocapError, unknown_name
-from imitwalk.mocap._common import (
-    check_keypoints,
-    euler_matrices,
-    read_lines,
-    snap_rate,
-    up_axis,
-    z_up,
+from imitwalk.mocap._common import UP_AXES, check_keypoints, read_lines, snap_rate, z_up
+from imitwalk.mocap.bounds import check_motion, drop_channels
+from imitwalk.mocap.bvh_parse import BvhFile, parse_bvh
+from imitwalk.mocap.motion import KEYPOINTS, LOWER_BODY, Motion
+from imitwalk.mocap.orient import (
+    UNITS_FLAG,
+    UP_VECTORS,
+    axis_name,
+    decide_forward,
+    decide_units,
+    decide_up,
 )
-from imitwalk.mocap.motion import KEYPOINTS, Motion
+from imitwalk.mocap.roles import assign_sides, leg_chains, load_joint_names, name_roles
+from imitwalk.mocap.skeleton import Joint, children, forward_kinematics, moving_columns
 
 __all__ = ["UNITS", "read_bvh"]
 
 #: Length units a BVH may use -> metres per unit.
 UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.0254 / 0.45}
 
-#: Standing hip height [m] of an adult, used to guess the units.
-HIP_HEIGHT_M = 0.9
-
-# Keypoint -> normalised joint names tried in order (normalised: lower case, no namespace
-# "xxx:", no "_ .-" or spaces, no 3ds Max "Bip01" prefix). Sided names accept the
-# prefixes/suffixes "left"/"l" (resp. "right"/"r"): LeftUpLeg, L_Thigh, upperleg.l, ...
-_CENTRAL = {
-    "pelvis": ("hips", "pelvis", "hip", "root"),
-    "neck": ("neck", "neck1", "neckbase"),
-    "head": ("head",),
-}
-_SIDED = {
-    "hip": ("upleg", "upperleg", "thigh", "hip", "femur"),
-    "knee": ("knee", "shin", "lowerleg", "calf", "leg", "tibia"),
-    "ankle": ("foot", "ankle"),
-    "toe": ("toebase", "toe", "toes", "toe0", "ball"),
-    "shoulder": ("arm", "upperarm", "humerus", "shoulder"),
-    "elbow": ("forearm", "lowerarm", "elbow", "radius"),
-    "wrist": ("hand", "wrist"),
-}
+_FEET = ("l_ankle", "r_ankle", "l_toe", "r_toe")
 
 
-def _candidates(key: str) -> tuple[str, ...]:
-    if key in _CENTRAL:
-        return _CENTRAL[key]
-    side, part = key.split("_")
-    words = ("left", "l") if side == "l" else ("right", "r")
-    return tuple(c for b in _SIDED[part] for w in words for c in (w + b, b + w))
+def _skip_tpose(bvh: BvhFile, skip_tpose: bool | None, src: str) -> tuple[int, bool]:
+    """Frames to drop at the start (0 or 1) and whether frame 0 looks like a T-pose."""
+    is_rot = np.array([c.endswith("rotation") for c in bvh.channels], dtype=bool)
+    v = bvh.values
+    first_int = bool(np.all(v[0, is_rot] == np.round(v[0, is_rot])))
+    tpose = bool(first_int and len(v) > 1 and not np.all(v[1, is_rot] == np.round(v[1, is_rot])))
+    skip = tpose if skip_tpose is None else skip_tpose
+    if skip and len(v) < 2:
+        raise MocapError(f"{src}: no motion frames after the T-pose frame")
+    return int(skip), tpose
 
 
-def _normalise(name: str) -> str:
-    name = name.rsplit(":", 1)[-1].rsplit("|", 1)[-1].lower()
-    return re.sub(r"^bip0*1", "", re.sub(r"[\s_.\-]", "", name))
+def _upper_body(joints: list[Joint], pelvis: int, hips: list[int]) -> list[int]:
+    """Joints below the pelvis that are not in a leg (the legs' branches left out)."""
+    kids = children(joints)
+    leg_roots = set()
+    for h in hips:
+        while joints[h].parent not in (pelvis, -1):
+            h = joints[h].parent
+        leg_roots.add(h)
+    out, stack = [], [c for c in kids[pelvis] if c not in leg_roots]
+    while stack:
+        j = stack.pop()
+        out.append(j)
+        stack.extend(kids[j])
+    return out
 
 
-@dataclass
-class _Joint:
-    name: str
-    parent: int
-    offset: np.ndarray
-    channels: list[str] = field(default_factory=list)
-    end_site: bool = False
-
-
-def _parse_hierarchy(lines: list[str], src: str) -> tuple[list[_Joint], int]:
-    """Parse HIERARCHY; return joints (parents first) and the index of the MOTION line."""
-    joints: list[_Joint] = []
-    stack: list[int] = []
-    pending: int | None = None
-    for i, raw in enumerate(lines):
-        tok = raw.split()
-        if not tok:
-            continue
-        key = tok[0].upper()
-        where = f"{src}: line {i + 1}"
-        if key == "MOTION":
-            if stack or not joints:
-                raise MocapError(f"{where}: MOTION before the hierarchy is closed")
-            return joints, i
-        if key in ("ROOT", "JOINT") or (key == "END" and len(tok) > 1):
-            is_end = key == "END"
-            if not is_end and len(tok) < 2:
-                raise MocapError(f"{where}: {tok[0]} without a name")
-            name = "" if is_end else raw.split(None, 1)[1].strip().rstrip("{").strip()
-            parent = stack[-1] if stack else -1
-            if is_end:
-                name = f"{joints[parent].name}_end" if parent >= 0 else "end"
-            joints.append(_Joint(name, parent, np.zeros(3), end_site=is_end))
-            pending = len(joints) - 1
-            if raw.rstrip().endswith("{"):
-                stack.append(pending)
-                pending = None
-        elif key == "{":
-            if pending is None:
-                raise MocapError(f"{where}: '{{' without a joint")
-            stack.append(pending)
-            pending = None
-        elif key == "}":
-            if not stack:
-                raise MocapError(f"{where}: unbalanced '}}'")
-            stack.pop()
-        elif key == "OFFSET":
-            if not stack or len(tok) < 4:
-                raise MocapError(f"{where}: malformed OFFSET")
-            joints[stack[-1]].offset = _floats(tok[1:4], where)
-        elif key == "CHANNELS":
-            if not stack or len(tok) < 2 or len(tok) != int(_floats(tok[1:2], where)[0]) + 2:
-                raise MocapError(f"{where}: malformed CHANNELS")
-            chans = [c.lower() for c in tok[2:]]
-            bad = [c for c in chans if c[:1] not in "xyz" or c[1:] not in ("position", "rotation")]
-            if bad:
-                raise MocapError(f"{where}: unknown channel {tok[2 + chans.index(bad[0])]}")
-            joints[stack[-1]].channels = chans
-        elif key != "HIERARCHY":
-            raise MocapError(f"{where}: unexpected {tok[0]!r} in the hierarchy")
-    raise MocapError(f"{src}: line {len(lines)}: file ends without a MOTION section (truncated?)")
-
-
-def _floats(tokens: list[str], where: str) -> np.ndarray:
-    try:
-        return np.array([float(t) for t in tokens])
-    except ValueError:
-        raise MocapError(f"{where}: non-numeric value in {' '.join(tokens)[:40]!r}") from None
-
-
-def _parse_motion(lines: list[str], start: int, n_chan: int, src: str) -> tuple[np.ndarray, float]:
-    """Parse the MOTION section from line index ``start``; return ``(T, C)`` values and dt [s]."""
-    header: dict[str, str] = {}
-    i = start + 1
-    for want in ("frames", "frame time"):
-        while i < len(lines) and not lines[i].strip():
-            i += 1
-        if i >= len(lines) or ":" not in lines[i]:
-            raise MocapError(f"{src}: line {i + 1}: expected '{want.title()}:' (file truncated?)")
-        k, v = lines[i].split(":", 1)
-        if k.strip().lower() != want:
-            raise MocapError(f"{src}: line {i + 1}: expected '{want.title()}:', got {k.strip()!r}")
-        header[want] = v.strip()
-        i += 1
-    n_frames = int(_floats([header["frames"]], f"{src}: line {start + 2}")[0])
-    dt = float(_floats([header["frame time"]], f"{src}: line {start + 3}")[0])
-    if n_frames < 1 or dt <= 0:
-        raise MocapError(f"{src}: bad motion header Frames: {n_frames}, Frame Time: {dt}")
-    rows: list[np.ndarray] = []
-    for j in range(i, len(lines)):
-        tok = lines[j].split()
-        if not tok:
-            continue
-        if len(rows) == n_frames:
-            raise MocapError(f"{src}: line {j + 1}: more frame lines than Frames: {n_frames}")
-        if len(tok) != n_chan:
-            raise MocapError(f"{src}: line {j + 1}: {len(tok)} values, expected {n_chan} channels")
-        rows.append(_floats(tok, f"{src}: line {j + 1}"))
-    if len(rows) < n_frames:
-        raise MocapError(
-            f"{src}: line {len(lines)}: file ends after {len(rows)} of {n_frames} frames "
-            "(truncated?)"
-        )
-    return np.array(rows), dt
-
-
-def _forward_kinematics(joints: list[_Joint], values: np.ndarray, scale: float) -> np.ndarray:
-    """Joint positions ``(T, J, 3)`` in file axes, metres, from ``(T, C)`` channel values."""
-    n = values.shape[0]
-    pos = np.zeros((n, len(joints), 3))
-    rot = np.zeros((n, len(joints), 3, 3))
-    col = 0
-    for j, jt in enumerate(joints):
-        local_t = np.broadcast_to(jt.offset * scale, (n, 3)).copy()
-        axes = ""
-        angle_cols: list[int] = []
-        for c in jt.channels:
-            axis = "xyz".index(c[0])
-            if c.endswith("position"):
-                local_t[:, axis] = values[:, col] * scale
-            else:
-                axes += c[0]
-                angle_cols.append(col)
-            col += 1
-        local_r = euler_matrices(axes, values[:, angle_cols])
-        if jt.parent < 0:
-            pos[:, j], rot[:, j] = local_t, local_r
-        else:
-            parent_r = rot[:, jt.parent]
-            pos[:, j] = pos[:, jt.parent] + np.einsum("tij,tj->ti", parent_r, local_t)
-            rot[:, j] = parent_r @ local_r
-    return pos
-
-
-def _keypoint_joints(joints: list[_Joint], src: str) -> dict[str, int]:
-    by_name: dict[str, int] = {}
-    for j, jt in enumerate(joints):
-        if not jt.end_site:
-            by_name.setdefault(_normalise(jt.name), j)
-    found: dict[str, int] = {}
-    for key in KEYPOINTS:
-        hit = next((by_name[c] for c in _candidates(key) if c in by_name), None)
-        if hit is None and key.endswith("_toe") and f"{key[0]}_ankle" in found:
-            ankle = found[f"{key[0]}_ankle"]  # no toe joint: use the foot's End Site
-            hit = next(
-                (j for j, jt in enumerate(joints) if jt.end_site and jt.parent == ankle), None
-            )
-        if hit is not None:
-            found[key] = hit
-    missing = [k for k in KEYPOINTS if k not in found]
-    if missing:
+def _legs(joints: list[Joint], pos: np.ndarray, named: dict[str, int], src: str):
+    """Leg joints by name if the names give them all, else the two chains by structure."""
+    if all(k in named for k in LOWER_BODY):
+        return None, [named[k] for k in _FEET], named["pelvis"], [named["l_hip"], named["r_hip"]]
+    chains = leg_chains(joints, pos)
+    if chains is None:
         names = ", ".join(jt.name for jt in joints if not jt.end_site)
         raise MocapError(
-            f"{src}: no joint found for keypoints {', '.join(missing)}; joints: {names}"
+            f"{src}: cannot find the legs: no joints named like a hip, knee and ankle "
+            f"(LeftUpLeg, UpperLeg_L, l_thigh, ...) and no two mirror-image chains below one "
+            f"joint; joints: {names}; map them with --joint-names FILE.json"
         )
-    return found
-
-
-def _rest_leg(joints: list[_Joint], hip: int, ankle: int, src: str) -> tuple[str, float]:
-    """Up axis and standing hip height (hip joint to the lowest point of its leg, file
-    units) of the rest pose (all rotations zero)."""
-    rest = np.zeros((len(joints), 3))
-    leg = [hip]
-    for j, jt in enumerate(joints):  # parents come first
-        rest[j] = jt.offset + (rest[jt.parent] if jt.parent >= 0 else 0.0)
-        if jt.parent in leg:
-            leg.append(j)
-    up = up_axis(rest[ankle] - rest[hip], src)
-    k = "xyz".index(up)
-    return up, float(rest[hip, k] - rest[leg, k].min())
+    feet = [c.ankle for c in chains] + [c.toe for c in chains]
+    return chains, feet, chains[0].pelvis, [c.hip for c in chains]
 
 
 def read_bvh(
-    path: str | Path, *, units: str | None = None, skip_tpose: bool | None = None
+    path: str | Path,
+    *,
+    units: str | None = None,
+    up: str | None = None,
+    joint_names: str | Path | dict[str, str] | None = None,
+    skip_tpose: bool | None = None,
 ) -> Motion:
     """Read a BVH file.
 
     Args:
         path: the ``.bvh`` file.
         units: length unit of the file, one of :data:`UNITS`; None guesses it from the
-            standing hip height.
+            animated leg length and pelvis height.
+        up: the file's up axis, one of ``x y z -x -y -z``; None guesses it (head above
+            the feet, the lowest foot at one height).
+        joint_names: a JSON file (or dict) keypoint -> joint name, for rigs whose names
+            are not recognised (see :mod:`imitwalk.mocap.roles`).
         skip_tpose: drop frame 0 if it is a converter T-pose; None detects it (integer
             rotation channels in frame 0 but not in frame 1).
 
     Returns:
         a :class:`Motion`: ``data`` ``(T, C)`` channel values as read (degrees, file
         units), ``keypoints`` ``(T, 3)`` [m] z up; ``meta`` has ``units``,
-        ``units_guessed``, ``up_axis``, ``hip_height_m``, ``skipped_frames``.
+        ``units_guessed``, ``up_axis``, ``up_guessed``, ``up_reason``, ``forward_axis``
+        (file axis nearest the direction of travel), ``leg_length_m``,
+        ``pelvis_height_m``, ``skipped_frames``, ``joints`` (keypoint -> joint name),
+        ``roles`` (``"names"`` or ``"structure"``), ``missing_keypoints``.
     """
     src = str(path)
     if units is not None and units not in UNITS:
         raise unknown_name("BVH unit", units, UNITS, MocapError)
-    lines = read_lines(path)
-    joints, motion_line = _parse_hierarchy(lines, src)
-    channels = tuple(f"{jt.name}.{c.capitalize()}" for jt in joints for c in jt.channels)
-    values, dt = _parse_motion(lines, motion_line, len(channels), src)
-    is_rot = np.array([c.endswith("rotation") for c in channels])
-    first_int = bool(np.all(values[0, is_rot] == np.round(values[0, is_rot])))
-    tpose = bool(
-        first_int
-        and len(values) > 1
-        and not np.all(values[1, is_rot] == np.round(values[1, is_rot]))
-    )
-    skip = tpose if skip_tpose is None else skip_tpose
-    values = values[1:] if skip else values
-    if len(values) < 1:
-        raise MocapError(f"{src}: no motion frames")
-    kp_joint = _keypoint_joints(joints, src)
-    up, hip_height = _rest_leg(joints, kp_joint["l_hip"], kp_joint["l_ankle"], src)
+    if up is not None and up not in UP_AXES:
+        raise unknown_name("up axis", up, UP_AXES, MocapError)
+    by_hand = load_joint_names(joint_names) if isinstance(joint_names, str | Path) else joint_names
+    bvh = parse_bvh(read_lines(path), src)
+    skip, tpose = _skip_tpose(bvh, skip_tpose, src)
+    values, rows = bvh.values[skip:], bvh.rows[skip:]
+    clean = np.where(np.isfinite(values), values, 0.0)
+    joints = bvh.joints
+    pos = forward_kinematics(joints, clean, 1.0)  # (T, J, 3) file axes and units
+    named = name_roles(joints, src, by_hand)
+    chains, feet, pelvis, hips = _legs(joints, pos, named, src)
+    legs = [pelvis, *hips, *_knees(named, chains), *feet]
+    if not np.all(np.isfinite(pos[:, legs])):
+        t = int(np.flatnonzero(~np.all(np.isfinite(pos[:, legs]), axis=(1, 2)))[0])
+        raise MocapError(
+            f"{src}: line {rows[t]}: the legs' positions overflow (a value too large?)"
+        )
+    leg = _leg_length(pos, hips, _knees(named, chains), feet[:2])
+    if not leg > 0:
+        raise MocapError(
+            f"{src}: the legs have zero length (hip, knee and ankle at one point in every "
+            "frame): zero-length bones in the rest pose?"
+        )
+    top_j = next((named[k] for k in ("head", "neck") if k in named), None)
+    top = pos[:, top_j] if top_j is not None else _centre(joints, pos, pelvis, hips)
+    feet_pos = pos[:, feet]  # (T, 4, 3)
+    up_guessed = up is None
+    why = "given"
+    if up is None:
+        up, why = decide_up(top, feet_pos, leg, src)
+    e_up = UP_VECTORS[up]
+    fwd, fwd_how = decide_forward(pos[:, pelvis], feet_pos[:, :2], feet_pos[:, 2:], e_up, leg)
+    roles = dict(named)
+    if chains is not None:
+        if not np.any(fwd):
+            raise MocapError(
+                f"{src}: cannot tell the left leg from the right (no travel, no toes); "
+                "map them with --joint-names FILE.json"
+            )
+        roles = {**assign_sides(chains, pos, e_up, fwd), **named}
+    height = float(np.median(pos[:, pelvis] @ e_up - np.min(feet_pos @ e_up, axis=1)))
     guessed = units is None
-    if guessed:
-        if hip_height <= 0:
-            raise MocapError(f"{src}: cannot guess units (rest-pose hip height {hip_height})")
-        units = min(UNITS, key=lambda u: abs(np.log(hip_height * UNITS[u] / HIP_HEIGHT_M)))
-    pos = z_up(_forward_kinematics(joints, values, UNITS[units]), up)
-    keypoints = check_keypoints({k: pos[:, j] for k, j in kp_joint.items()}, src, len(values))
+    units = decide_units(leg, height, UNITS, src) if units is None else units
+    used = moving_columns(joints, roles.values())
+    _check_used(values, bvh.channels, used, rows, src)
+    data, channels, dropped = drop_channels(values, bvh.channels, used, src)
+    pos_m = z_up(forward_kinematics(joints, clean, UNITS[units]), up)
+    keypoints = check_keypoints(
+        {k: pos_m[:, roles[k]] for k in KEYPOINTS if k in roles}, src, len(values)
+    )
     meta = {
         "units": units,
         "units_guessed": guessed,
         "up_axis": up,
-        "hip_height_m": hip_height * UNITS[units],
-        "skipped_frames": int(skip),
+        "up_guessed": up_guessed,
+        "up_reason": why,
+        "forward_axis": axis_name(fwd) if np.any(fwd) else "",
+        "forward_from": fwd_how,
+        "leg_length_m": leg * UNITS[units],
+        "pelvis_height_m": height * UNITS[units],
+        "skipped_frames": skip,
         "tpose_detected": tpose,
-        "joints": {k: joints[j].name for k, j in kp_joint.items()},
+        "joints": {k: joints[j].name for k, j in roles.items() if k in KEYPOINTS},
+        "roles": "names" if chains is None else "structure",
+        "missing_keypoints": tuple(k for k in KEYPOINTS if k not in roles),
+        "dropped_channels": dropped,
     }
-    return Motion(snap_rate(1.0 / dt), channels, values, keypoints, src, "bvh", meta=meta)
+    fps = snap_rate(1.0 / bvh.frame_time)
+    motion = Motion(fps, channels, data, keypoints, src, "bvh", meta=meta)
+    return check_motion(motion, f"{UNITS_FLAG} (read as {units})")
+
+
+def _leg_length(pos: np.ndarray, hips: list[int], knees: list[int], ankles: list[int]) -> float:
+    """Mean over both legs of the median hip -> knee -> ankle length (units of ``pos``)."""
+    out = []
+    for hip, knee, ankle in zip(hips, knees, ankles, strict=True):
+        thigh = np.linalg.norm(pos[:, knee] - pos[:, hip], axis=1)
+        out.append(np.median(thigh + np.linalg.norm(pos[:, ankle] - pos[:, knee], axis=1)))
+    return float(np.mean(out))
+
+
+def _knees(named: dict[str, int], chains) -> list[int]:
+    if chains is None:
+        return [named["l_knee"], named["r_knee"]]
+    return [c.knee for c in chains]
+
+
+def _centre(joints: list[Joint], pos: np.ndarray, pelvis: int, hips: list[int]) -> np.ndarray:
+    """``(T, 3)`` mean of the upper-body joints (the pelvis if there are none)."""
+    upper = [j for j in _upper_body(joints, pelvis, hips) if np.all(np.isfinite(pos[:, j]))]
+    return pos[:, upper].mean(axis=1) if upper else pos[:, pelvis]
+
+
+def _check_used(values: np.ndarray, channels, used: np.ndarray, rows: np.ndarray, src: str):
+    """A non-finite value in a channel that moves a keypoint -> MocapError naming its line."""
+    bad = ~np.isfinite(values) & used
+    if bad.any():
+        t, c = (int(i[0]) for i in np.nonzero(bad))
+        raise MocapError(
+            f"{src}: line {rows[t]}: channel {channels[c]} is {values[t, c]}, "
+            "and it moves a keypoint"
+        )

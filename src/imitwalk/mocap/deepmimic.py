@@ -22,6 +22,7 @@ import numpy as np
 
 from imitwalk.errors import MocapError
 from imitwalk.mocap._common import check_keypoints, quat_wxyz_matrices, snap_rate, z_up
+from imitwalk.mocap.bounds import check_motion, check_rate, drop_channels
 from imitwalk.mocap.motion import Motion
 
 __all__ = ["OFFSETS", "SCALE", "read_deepmimic"]
@@ -101,6 +102,34 @@ def _z_rotations(angle: np.ndarray) -> np.ndarray:
     return out
 
 
+def _frames(p: Path, src: str) -> tuple[np.ndarray, str]:
+    """The ``(T, 44)`` frames of a DeepMimic file as floats, and its ``"Loop"`` mode."""
+    if not p.is_file():
+        raise MocapError(f"mocap file not found: {p}")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError, RecursionError, OSError) as exc:
+        what = "nested too deeply" if isinstance(exc, RecursionError) else str(exc)
+        raise MocapError(f"{src}: not DeepMimic JSON: {what}".replace("\n", " ")[:300]) from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("Frames"), list):
+        raise MocapError(f"{src}: no 'Frames' list (not a DeepMimic motion file?)")
+    frames = doc["Frames"]
+    if len(frames) < 2:
+        raise MocapError(f"{src}: 'Frames' holds {len(frames)} frame(s), need >= 2")
+    for i, fr in enumerate(frames):
+        if not isinstance(fr, list) or len(fr) != 44:
+            got = len(fr) if isinstance(fr, list) else type(fr).__name__
+            raise MocapError(f"{src}: frame {i} has {got} values, expected 44")
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in fr):
+            raise MocapError(f"{src}: frame {i}: a value is not a number")
+    try:
+        data = np.array(frames, dtype=float)
+    except OverflowError:
+        raise MocapError(f"{src}: a number in 'Frames' is too large for a float") from None
+    loop = doc.get("Loop", "none")
+    return data, loop if isinstance(loop, str) else str(loop)[:20]
+
+
 def read_deepmimic(path: str | Path) -> Motion:
     """Read a DeepMimic motion file (``.txt`` or ``.json``).
 
@@ -109,32 +138,26 @@ def read_deepmimic(path: str | Path) -> Motion:
         [m] z up, ``fps = 1/dt`` of the first frame, ``loop`` if ``"Loop": "wrap"``.
     """
     src = str(path)
-    p = Path(path)
-    if not p.is_file():
-        raise MocapError(f"mocap file not found: {p}")
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise MocapError(f"{src}: not DeepMimic JSON: {exc}".replace("\n", " ")) from None
-    if not isinstance(doc, dict) or "Frames" not in doc:
-        raise MocapError(f"{src}: no 'Frames' list (not a DeepMimic motion file?)")
-    frames = doc["Frames"]
-    for i, fr in enumerate(frames):
-        if not isinstance(fr, list) or len(fr) != 44:
-            got = len(fr) if isinstance(fr, list) else type(fr).__name__
-            raise MocapError(f"{src}: frame {i} has {got} values, expected 44")
-    try:
-        data = np.array(frames, dtype=float).reshape(len(frames), 44)
-    except (TypeError, ValueError):
-        raise MocapError(f"{src}: non-numeric value in 'Frames'") from None
-    if len(data) < 2 or not np.all(np.isfinite(data)) or data[0, 0] <= 0:
-        raise MocapError(f"{src}: need >= 2 finite frames with dt > 0 in the first")
+    data, mode = _frames(Path(path), src)
+    channels = _channels()
+    bad = ~np.isfinite(data[:, 1:])
+    if bad.any():
+        t, k = (int(i[0]) for i in np.nonzero(bad))
+        raise MocapError(f"{src}: frame {t}: {channels[1 + k]} is {data[t, 1 + k]}, not finite")
+    if not (np.isfinite(data[0, 0]) and data[0, 0] > 0):
+        raise MocapError(f"{src}: frame 0: dt {data[0, 0]} must be a finite time > 0 s")
+    fps = check_rate(1.0 / float(data[0, 0]), f"{src}: frame 0: dt {data[0, 0]:.6g} s")
+    used = np.arange(data.shape[1]) > 0  # every column but the per-frame dt moves a keypoint
+    kept, kept_channels, dropped = drop_channels(data, channels, used, src)
     n = len(data)
     rot: dict[str, np.ndarray] = {}
     pos: dict[str, np.ndarray] = {"root": data[:, 1:4]}
     for link, (col, width) in _COLUMNS.items():
         vals = data[:, col : col + width]
-        rot[link] = quat_wxyz_matrices(vals) if width == 4 else _z_rotations(vals[:, 0])
+        try:
+            rot[link] = quat_wxyz_matrices(vals) if width == 4 else _z_rotations(vals[:, 0])
+        except MocapError as exc:
+            raise MocapError(f"{src}: {link}: {exc}") from None
     rot["right_wrist"] = rot["left_wrist"] = np.broadcast_to(np.eye(3), (n, 3, 3))
     for link, (parent, offset) in OFFSETS.items():
         pos[link] = pos[parent] + rot[parent] @ (SCALE * np.array(offset))  # parents first
@@ -143,17 +166,11 @@ def read_deepmimic(path: str | Path) -> Motion:
     for key, (link, offset) in _POINTS.items():
         keypoints[key] = pos[link] + rot[link] @ (SCALE * np.array(offset))
     keypoints = check_keypoints({k: z_up(v, "y") for k, v in keypoints.items()}, src, n)
-    loop = doc.get("Loop", "none") == "wrap"
-    meta: dict = {"loop_mode": doc.get("Loop", "none")}
+    loop = mode == "wrap"
+    meta: dict = {"loop_mode": mode, "dropped_channels": dropped}
     if loop:
         meta["period_frames"] = n - 1
-    return Motion(
-        snap_rate(1.0 / data[0, 0]),
-        _channels(),
-        data,
-        keypoints,
-        src,
-        "deepmimic",
-        loop=loop,
-        meta=meta,
+    motion = Motion(
+        snap_rate(fps), kept_channels, kept, keypoints, src, "deepmimic", loop=loop, meta=meta
     )
+    return check_motion(motion)

@@ -10,9 +10,11 @@ Conventions (all readers):
   stage works out the heading.
 * required keypoints: the lower body, :data:`LOWER_BODY` (pelvis, hips, knees, ankles,
   toes), from every reader; a file that cannot give them raises ``MocapError``.
-  BVH, ASF/AMC and DeepMimic give all of :data:`KEYPOINTS`. For C3D the trunk, head and
-  arm keypoints are optional: those whose markers the file lacks are absent from
-  ``keypoints`` and listed in ``meta["missing_keypoints"]``.
+  ASF/AMC and DeepMimic give all of :data:`KEYPOINTS`. For BVH and C3D the trunk, head
+  and arm keypoints are optional: those the rig does not name (or whose markers the file
+  lacks) are absent from ``keypoints`` and listed in ``meta["missing_keypoints"]``.
+* bounds: every reader holds its Motion to :mod:`imitwalk.mocap.bounds` (frame rate,
+  leg length, finite keypoints near the pelvis, finite ``data``).
 * keypoint meaning: joint centres. ``pelvis`` is the root of a skeleton (for CMU rigs
   ~10 cm above the hip centres, for DeepMimic at hip height) and the mid-point of the
   hip centres for C3D; ``l_toe``/``r_toe`` is the ball of the foot (toe joint of a
@@ -21,6 +23,8 @@ Conventions (all readers):
 * ``data``: the per-frame values as read (BVH/AMC channels in degrees or the
   file's units, C3D marker coordinates in the file's units with invalid samples
   as NaN, DeepMimic frame vectors), ``(T, D)``, with ``channels`` naming the ``D`` columns.
+  Columns with non-finite values that move no keypoint are dropped (with a warning) and
+  named in ``meta["dropped_channels"]``; elsewhere ``data`` is finite.
 """
 
 from __future__ import annotations

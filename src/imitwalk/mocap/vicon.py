@@ -25,22 +25,20 @@ filled (:func:`imitwalk.mocap.gaps.fill_gaps`) and noted in ``Motion.filled``.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-import c3d
 import numpy as np
 
 from imitwalk.errors import MocapError, unknown_name
-from imitwalk.mocap._common import check_keypoints, snap_rate, up_axis, z_up
+from imitwalk.mocap._common import UP_AXES, check_keypoints, z_up
+from imitwalk.mocap.bounds import check_leg, check_motion
+from imitwalk.mocap.c3d_file import POINT_UNITS, read_trial
 from imitwalk.mocap.gaps import GapTooLong, fill_gaps
 from imitwalk.mocap.motion import KEYPOINTS, LOWER_BODY, Motion
+from imitwalk.mocap.orient import decide_up
 
 __all__ = ["MARKER_ALIASES", "POINT_UNITS", "read_c3d"]
-
-#: POINT:UNITS -> metres per unit.
-POINT_UNITS = {"mm": 0.001, "cm": 0.01, "m": 1.0}
 
 #: Plug-in-Gait role (left side; right is the same with "R") -> accepted labels.
 MARKER_ALIASES: dict[str, tuple[str, ...]] = {
@@ -95,56 +93,20 @@ def _hip_centres(lasi, rasi, back) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-def _read(path: str | Path) -> tuple[c3d.Reader, np.ndarray, list[str]]:
-    p = Path(path)
-    if not p.is_file():
-        raise MocapError(f"mocap file not found: {p}")
-    try:
-        with p.open("rb") as handle, warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message="No analog data", category=UserWarning)
-            reader = c3d.Reader(handle)
-            frames = [pts[:, :4].copy() for _, pts, _ in reader.read_frames(copy=True)]
-    except Exception as exc:  # the c3d package raises bare ValueError/struct.error/...
-        raise MocapError(f"{p}: not a readable C3D file: {exc}".replace("\n", " ")) from None
-    if not frames:
-        raise MocapError(f"{p}: C3D file has no frames")
-    pts = np.array(frames, dtype=float)  # (T, N, 4): x, y, z, residual
-    bad = (pts[:, :, 3] < 0) | np.all(pts[:, :, :3] == 0, axis=2)
-    xyz = np.where(bad[:, :, None], np.nan, pts[:, :, :3])
-    labels = [str(s).strip() for s in reader.point_labels]
-    return reader, xyz, labels
-
-
-def _param(reader: c3d.Reader, key: str, default: float) -> float:
-    p = reader.get(key)
-    return float(p.float_value) if p is not None and p.total_bytes >= 4 else default
-
-
-def _events(reader: c3d.Reader, fps: float) -> list[tuple[str, str, float, int]]:
-    """(context, label, time [s], frame index) of each C3D event, by time."""
-    group = reader.get("EVENT")
-    if group is None or group.get("TIMES") is None or group.get("LABELS") is None:
-        return []
-    times = np.asarray(group.get("TIMES").float_array, dtype=float).reshape(-1, 2)
-    labels = [s.strip() for s in np.atleast_1d(group.get("LABELS").string_array)]
-    ctx_p = group.get("CONTEXTS")
-    contexts = (
-        [s.strip() for s in np.atleast_1d(ctx_p.string_array)] if ctx_p else [""] * len(labels)
-    )
-    out = []
-    for (minutes, seconds), label, ctx in zip(times, labels, contexts, strict=False):
-        t = 60.0 * minutes + seconds
-        out.append((ctx, label, float(t), int(round(t * fps)) + 1 - int(reader.first_frame)))
-    return sorted(out, key=lambda e: e[2])
-
-
-def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool = True) -> Motion:
+def read_c3d(
+    path: str | Path,
+    *,
+    max_gap: float = 0.1,
+    use_model_outputs: bool = True,
+    up: str | None = None,
+) -> Motion:
     """Read a C3D trial.
 
     Args:
-        path: the ``.c3d`` file.
+        path: the ``.c3d`` file (checked by :func:`~imitwalk.mocap.c3d_file.read_trial`).
         max_gap: longest gap [s] of a marker that is filled by interpolation.
         use_model_outputs: use Plug-in-Gait joint centres when the file has them.
+        up: the lab's up axis (``x y z -x -y -z``); None tells it from the motion.
 
     Returns:
         a :class:`Motion`: ``data`` ``(T, 3 N)`` every POINT label (markers and model
@@ -153,15 +115,10 @@ def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool 
         (context, label, time [s], frame index), ``first_frame``.
     """
     src = str(path)
-    reader, xyz, labels = _read(path)
-    fps = snap_rate(float(reader.point_rate))
-    units = (
-        str(reader.get("POINT:UNITS").string_value).strip().lower()
-        if reader.get("POINT:UNITS")
-        else "mm"
-    )
-    if units not in POINT_UNITS:
-        raise unknown_name("C3D POINT:UNITS", units, POINT_UNITS, MocapError)
+    if up is not None and up not in UP_AXES:
+        raise unknown_name("up axis", up, UP_AXES, MocapError)
+    trial = read_trial(path)
+    xyz, labels, fps, units = trial.xyz, trial.labels, trial.fps, trial.units
     to_mm = POINT_UNITS[units] * 1000.0
     # lookup by upper-case label without a "Subject:" prefix; the first of duplicates wins
     index = {lab.rsplit(":", 1)[-1].upper(): i for i, lab in reversed(list(enumerate(labels)))}
@@ -210,8 +167,8 @@ def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool 
         kp["pelvis"] = (kp["l_hip"] + kp["r_hip"]) / 2
         for s in "LR":
             k = s.lower()
-            knee_off = _param(reader, f"PROCESSING:{s}KNEEWIDTH", 100.0) / 2 + _MARKER_RADIUS_MM
-            ankle_off = _param(reader, f"PROCESSING:{s}ANKLEWIDTH", 70.0) / 2 + _MARKER_RADIUS_MM
+            knee_off = trial.widths.get(f"{s}KNEEWIDTH", 100.0) / 2 + _MARKER_RADIUS_MM
+            ankle_off = trial.widths.get(f"{s}ANKLEWIDTH", 70.0) / 2 + _MARKER_RADIUS_MM
             lat = marker(f"{s}KNE")
             kp[f"{k}_knee"] = (
                 (lat + marker(f"{s}KNM")) / 2
@@ -239,8 +196,14 @@ def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool 
             kp[key] = make()
         except MocapError:
             missing.append(key)
-    hips_to_ankles = np.nanmean(kp["l_ankle"] - kp["l_hip"], axis=0)
-    up = up_axis(hips_to_ankles, src)
+    guessed = up is None
+    if up is None:
+        feet = np.stack([kp[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
+        leg = np.nanmedian(np.linalg.norm(kp["l_knee"] - kp["l_hip"], axis=1))
+        leg += np.nanmedian(np.linalg.norm(kp["l_ankle"] - kp["l_knee"], axis=1))  # [mm]
+        check_leg(float(leg) / 1000.0, src, "check POINT:UNITS")
+        top = kp.get("neck", kp["pelvis"])
+        up, _ = decide_up(top, feet, float(leg), src)
     keypoints = check_keypoints(
         {k: z_up(kp[k] / 1000.0, up) for k in KEYPOINTS if k in kp}, src, len(xyz), LOWER_BODY
     )
@@ -248,10 +211,12 @@ def read_c3d(path: str | Path, *, max_gap: float = 0.1, use_model_outputs: bool 
     meta = {
         "units": units,
         "up_axis": up,
+        "up_guessed": guessed,
         "hip_method": "plug-in-gait outputs" if use_pig else "harrington2007",
         "missing_keypoints": tuple(missing),
-        "events": _events(reader, fps),
-        "first_frame": int(reader.first_frame),
+        "events": list(trial.events),
+        "first_frame": trial.first_frame,
     }
     data = xyz.reshape(len(xyz), -1)
-    return Motion(fps, channels, data, keypoints, src, "c3d", filled=tuple(filled), meta=meta)
+    motion = Motion(fps, channels, data, keypoints, src, "c3d", filled=tuple(filled), meta=meta)
+    return check_motion(motion, "check POINT:UNITS")

@@ -89,6 +89,7 @@ class RetargetResult:
             "frames": self.motion_frames,
             "fps": self.motion_fps,
             "cycles_found": len(self.template.cycles),
+            "cycles_used": self.template.meta.get("cycles_report", ""),
             "cycle_period_s": self.template.period,
             "human_stride_m": self.template.stride,
             "human_speed_mps": self.template.speed,
@@ -148,7 +149,7 @@ def retarget(
         if off := off_grid(cfg.scales, sc.refine_scales):
             grid = ", ".join(f"{x:g}" for x in cfg.scales)
             raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
-    template = extract_template(motion)
+    template = extract_template(motion, allow_turn=bool(cfg.command.turn_deg))
     dt = 1.0 / cfg.control_hz
     t0 = time.perf_counter()
     if cfg.mapping == "paper" and not cfg.command.straight:

@@ -19,6 +19,7 @@ from imitwalk.errors import MocapError
 from imitwalk.mocap.cycles import find_cycles, foot_contacts, heading, heel_strikes
 from imitwalk.mocap.filters import period_frames, smooth
 from imitwalk.mocap.motion import Motion
+from imitwalk.mocap.selection import choose_cycles
 
 __all__ = ["PHASES", "GaitTemplate", "extract_template"]
 
@@ -42,7 +43,11 @@ class GaitTemplate:
             forward) and elbow flexion [rad] over ψ.
         waist: ``(PHASES,)`` yaw of the shoulder line relative to the hip line [rad].
         arms_measured: False if the clip has no arm keypoints (arm profiles are zero).
-        cycles: ``(start, end)`` source frames of the cycles averaged.
+        cycles: ``(start, end)`` source frames of the cycles averaged (the straight,
+            steady ones: :func:`~imitwalk.mocap.selection.choose_cycles`).
+        meta: ``n_cycles``, ``loop``, ``cycle_choice`` (the
+            :class:`~imitwalk.mocap.selection.CycleChoice`) and ``cycles_report`` (one
+            line: the frames used and why, those left out and why).
     """
 
     period: float
@@ -96,11 +101,17 @@ def _runs(mask: np.ndarray, start: int) -> np.ndarray:
     return np.flatnonzero(d == (-1 if start else 1)) + 1
 
 
-def extract_template(motion: Motion, cutoff_hz: float = 6.0) -> GaitTemplate:
-    """Average the whole gait cycles of ``motion`` into a :class:`GaitTemplate`.
+def extract_template(
+    motion: Motion, cutoff_hz: float = 6.0, *, allow_turn: bool = False
+) -> GaitTemplate:
+    """Average the straight, steady gait cycles of ``motion`` into a :class:`GaitTemplate`.
+
+    Args:
+        allow_turn: a turn is commanded, so cycles that turn may be used
+            (:func:`~imitwalk.mocap.selection.choose_cycles`).
 
     Raises:
-        MocapError: the clip holds no walking cycle.
+        MocapError: the clip holds no straight, steady walking cycle.
     """
     sm = smooth(motion, min(cutoff_hz, 0.4 * motion.fps))
     contacts = foot_contacts(sm)
@@ -115,6 +126,9 @@ def extract_template(motion: Motion, cutoff_hz: float = 6.0) -> GaitTemplate:
     else:
         kp = sm.keypoints
         cycles = find_cycles(sm, "l")
+    # a loop's turn shows in its raw frames (smoothing makes the loop periodic)
+    choice = choose_cycles(motion if motion.loop else sm, cycles, allow_turn=allow_turn)
+    cycles = list(choice.cycles)
     fwd_all = heading(sm)
     if motion.loop:
         fwd_all = np.tile(fwd_all[: period_frames(sm)], (3, 1))
@@ -141,7 +155,12 @@ def extract_template(motion: Motion, cutoff_hz: float = 6.0) -> GaitTemplate:
         cycles=tuple((int(a), int(b)) for a, b in cycles),
         fps=float(motion.fps),
         source=motion.source,
-        meta={"n_cycles": len(cycles), "loop": motion.loop},
+        meta={
+            "n_cycles": len(cycles),
+            "loop": motion.loop,
+            "cycle_choice": choice,
+            "cycles_report": choice.summary(),
+        },
     )
 
 

@@ -99,14 +99,16 @@ def _geom(m: mujoco.MjModel, g: int, shift: np.ndarray, meshes: dict | None) -> 
     return f"<collision>{origin}<geometry>{shape}</geometry></collision>"
 
 
-def to_urdf(robot: Robot) -> UrdfRobot:
-    """Write ``robot``'s compiled MuJoCo model as URDF.
+def to_urdf(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> UrdfRobot:
+    """Write ``robot``'s compiled MuJoCo model as URDF, with the torso's centre of mass
+    moved by ``com_shift`` ``(3,)`` [m] in its own frame (as ``SimOptions.com_shift``).
 
     Raises:
         RobotError: a body with more than one joint, or a joint other than a hinge below
             the root (URDF has one joint per link).
     """
     m = robot.compile()
+    m.body_ipos[m.body(robot.torso).id] += np.asarray(com_shift, dtype=float)
     names = [m.body(b).name or f"body{b}" for b in range(m.nbody)]
     shift = np.zeros((m.nbody, 3))
     joint_of: dict[int, int] = {}
@@ -188,15 +190,17 @@ def _obj(m: mujoco.MjModel, mid: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: One URDF file per robot and process: ``(name, mjcf) -> (path, UrdfRobot)``.
-_FILES: dict[tuple[str, str], tuple[Path, UrdfRobot]] = {}
+#: One URDF file per robot, torso shift and process: ``(name, mjcf, shift) -> (path, UrdfRobot)``.
+_FILES: dict[tuple, tuple[Path, UrdfRobot]] = {}
 
 
-def urdf_file(robot: Robot) -> tuple[Path, UrdfRobot]:
-    """``robot`` as URDF, written once per process to a temporary folder."""
-    key = (robot.name, str(robot.mjcf))
+def urdf_file(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> tuple[Path, UrdfRobot]:
+    """``robot`` as URDF (see :func:`to_urdf`), written once per process to a temporary
+    folder."""
+    shift = tuple(float(x) for x in com_shift)
+    key = (robot.name, str(robot.mjcf), shift)
     if key not in _FILES:
-        u = to_urdf(robot)
+        u = to_urdf(robot, shift)
         path = Path(tempfile.mkdtemp(prefix="imitwalk-")) / f"{robot.name}.urdf"
         for name, text in u.meshes.items():
             (path.parent / name).write_text(text)

@@ -1,0 +1,152 @@
+"""Robustness protocols: shipped files, validation, and that every drawn range is real."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from imitwalk.cli import main
+from imitwalk.errors import ConfigError
+from imitwalk.perturb import perturbed
+from imitwalk.protocol import FACTORS, PROTOCOLS, load_protocol
+from imitwalk.robots import load_robot
+from imitwalk.sim import MujocoPlant, SimOptions, make_plant
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return load_robot("hoap2")
+
+
+def test_the_shipped_protocols_load_and_name_their_sources():
+    assert {"eval", "hard", "bullet"} <= set(PROTOCOLS)
+    for name in PROTOCOLS:
+        p = load_protocol(name)
+        assert p.name == name and p.version >= 1
+        for factor, spec in p.factors.items():
+            assert factor in FACTORS and spec["source"].strip()
+
+
+def test_eval_draws_the_robots_figures_were_judged_on_before(robot):
+    p = load_protocol("eval")
+    for seed in range(40):
+        assert p.draw(seed, robot).options == perturbed(seed, disturbance=seed != 0)
+    assert load_protocol("bullet").engine == "bullet"
+    assert load_protocol("bullet").draw(7, robot).options == p.draw(7, robot).options
+
+
+def test_hard_draws_cover_their_ranges(robot):
+    p = load_protocol("hard")
+    draws = [p.draw(s, robot, seconds=30.0) for s in range(40)]
+    opts = [d.options for d in draws]
+    friction = np.array([o.friction for o in opts])
+    assert friction.min() >= 0.4 and friction.max() <= 1.5 and np.ptp(friction) > 0.7
+    slope = np.array([o.slope_deg for o in opts])
+    assert np.abs(slope).max() <= 3.0 and slope.min() < -1.5 < 1.5 < slope.max()
+    delay = np.array([o.servo_delay for o in opts])
+    assert delay.min() >= 0.0 and delay.max() <= 0.01 and np.ptp(delay) > 0.005
+    shift = np.array([o.com_shift for o in opts])
+    c = 0.025 * robot.height / 1.3
+    assert np.abs(shift[:, :2]).max() <= c + 1e-12 and np.abs(shift[:, :2]).max() > 0.7 * c
+    assert all(o.mass_jitter == 0.15 and o.kp_jitter == 0.20 for o in opts)
+    assert all(o.gyro_noise == 0.05 and o.accel_noise == 0.2 for o in opts)
+    top = 0.5 * np.sqrt(robot.height / 1.3)  # Froude-scaled: 0.31 m/s for hoap2
+    for o in opts:
+        t = np.array([k[0] for k in o.pushes])
+        gaps = np.diff(np.r_[0.0, t])
+        assert 3.0 - 1e-9 <= gaps.min() and gaps.max() <= 6.0 + 1e-9 and t.max() < 30.0
+        speed = np.hypot(*np.array([k[1:] for k in o.pushes]).T)
+        assert speed.max() <= top + 1e-12
+    speeds = np.concatenate([np.hypot(*np.array([k[1:] for k in o.pushes]).T) for o in opts])
+    assert speeds.max() > 0.9 * top
+    for d in draws:  # every drawn factor has a percentile; the furthest is one of them
+        assert set(d.deviation) <= set(FACTORS) and d.furthest in d.deviation
+        assert all(0.0 <= v <= 1.0 for v in d.deviation.values())
+    assert p.draw(3, robot) == p.draw(3, robot)  # a seed is one robot
+
+
+def test_the_draws_reach_the_simulators(robot):
+    """Friction, masses, servo stiffness and the torso's centre of mass are applied in
+    MuJoCo; friction and the shift in Bullet too."""
+    o = load_protocol("hard").draw(5, robot).options
+    m = MujocoPlant(robot, o).model
+    base = MujocoPlant(robot, SimOptions()).model
+    assert np.allclose(m.geom_friction[:, 0], o.friction)
+    assert not np.allclose(m.body_mass, base.body_mass)
+    assert not np.allclose(m.actuator_gainprm[:, 0], base.actuator_gainprm[:, 0])
+    torso = m.body(robot.torso).id
+    assert np.allclose(m.body_ipos[torso] - base.body_ipos[torso], o.com_shift)
+    import pybullet as pb
+
+    b = make_plant(robot, o, "bullet")
+    link = b._link_of_body[torso]
+    mu = pb.getDynamicsInfo(b.body, link, physicsClientId=b.client)[1]
+    assert mu == pytest.approx(o.friction)
+
+
+def _write(tmp_path, data) -> str:
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+def _hard(**factors) -> dict:
+    data = load_protocol("hard").to_dict()
+    data["factors"] = {**data["factors"], **factors}
+    return data
+
+
+PUSH = {"every_min_s": 3, "every_max_s": 6, "max_speed": 0.5, "at_height_m": 1.3, "source": "x"}
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"nosuch": 1}, r"unknown key in protocol .*'nosuch'; valid: description"),
+        (
+            {"factors": {"windy": {"source": "x"}}},
+            r"unknown factor in protocol .*'windy'; valid: .*friction",
+        ),
+        (
+            {"factors": {"friction": {"min": 1.2, "max": 0.5, "nominal": 1, "source": "x"}}},
+            r"friction: min 1.2 is above max 0.5",
+        ),
+        (
+            {"factors": {"pushes": {**PUSH, "max_speed": -0.5}}},
+            r"pushes.max_speed is negative",
+        ),
+        ({"factors": {"mass": {"spread": 0.1}}}, r"factor 'mass' lacks 'source'"),
+        ({"factors": {"mass": {"spread": "big", "source": "x"}}}, r"mass.spread must be a finite"),
+    ],
+)
+def test_bad_protocol_files_get_one_line(tmp_path, change, message):
+    data = {"name": "mine", "factors": {}}
+    data.update(change)
+    with pytest.raises(ConfigError, match=message) as info:
+        load_protocol(_write(tmp_path, data))
+    assert "\n" not in str(info.value)
+
+
+def test_an_unknown_protocol_lists_the_shipped_ones():
+    with pytest.raises(ConfigError, match=r"unknown protocol 'harder'; valid: bullet, eval, hard"):
+        load_protocol("harder")
+
+
+def test_a_users_protocol_file_works_as_a_shipped_one(tmp_path, robot):
+    path = _write(tmp_path, _hard())
+    assert load_protocol(path).draw(4, robot) == load_protocol("hard").draw(4, robot)
+
+
+@pytest.mark.parametrize(
+    "protocol, expect",
+    [("nosuch", "unknown protocol 'nosuch'"), ("bad.json", "protocol file not found")],
+)
+def test_cli_bad_protocol_exits_2(tmp_path, capsys, protocol, expect):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "config.json").write_text('{"learn": {}, "robot": "hoap2"}')
+    assert main(["evaluate", str(run), "--protocol", protocol]) == 2
+    err = capsys.readouterr().err
+    assert expect in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
