@@ -40,6 +40,17 @@ def shared_mocap() -> Path:
 
 
 @pytest.fixture(scope="session")
+def shared_robots() -> Path:
+    """Folder of the third-party robots (ROBOTIS OP3, Unitree G1): ``$IMITWALK_SHARED_ROBOTS``,
+    else ``<repo root>/../shared/robots``; skips the test if it is absent."""
+    env = os.environ.get("IMITWALK_SHARED_ROBOTS")
+    path = Path(env) if env else Path(__file__).resolve().parents[1].parent / "shared" / "robots"
+    if not path.is_dir():
+        pytest.skip(f"shared robots folder not found: {path} (set IMITWALK_SHARED_ROBOTS)")
+    return path
+
+
+@pytest.fixture(scope="session")
 def robot():
     """The built-in HOAP-2-class robot."""
     from imitwalk.robots import load_robot

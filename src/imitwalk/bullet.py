@@ -27,6 +27,7 @@ import numpy as np
 import pybullet as pb
 
 from imitwalk.robots import Robot
+from imitwalk.robots.servos import actuator_kind, torque_limit
 from imitwalk.robots.urdf import urdf_file
 from imitwalk.servo import StablePD
 from imitwalk.simtypes import (
@@ -97,10 +98,18 @@ class BulletPlant:
         self._qadr = m.jnt_qposadr[jid]
         self._dof = [joint[j] for j in robot.mj_joints]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
-        act = np.array([act_for[j] for j in jid])
-        kd = -m.actuator_biasprm[act, 2] + m.dof_damping[m.jnt_dofadr[jid]]
+        # hinges without a role that have a position servo hold the standing posture
+        held = [j for j in act_for if j not in jid and m.joint(j).name in joint]
+        held = [j for j in held if actuator_kind(m, act_for[j]) == "position"]
+        self._held = [joint[m.joint(j).name] for j in held]
+        self._held_target = robot.stand_qpos[m.jnt_qposadr[held]] if held else np.zeros(0)
+        every = [*jid, *held]
+        act = np.array([act_for[j] for j in every])
+        kd = -m.actuator_biasprm[act, 2] + m.dof_damping[m.jnt_dofadr[every]]
         self.limit = robot.torque_limit
-        self.servo = StablePD(robot.kp * kps, kd, self.limit, self.dt)
+        limit = np.r_[self.limit, [torque_limit(m, act_for[j], j) for j in held]]
+        kp = np.r_[robot.kp * kps, m.actuator_gainprm[[act_for[j] for j in held], 0]]
+        self.servo = StablePD(kp, kd, limit, self.dt)
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
@@ -177,7 +186,8 @@ class BulletPlant:
         w, x, y, z = qpos[3:7]
         orn = [x, y, z, w]
         self._place_base([0.0, 0.0, 0.0], orn)
-        for i, angle in zip(self._dof, qpos[self._qadr], strict=True):
+        angles = np.r_[qpos[self._qadr], self._held_target]
+        for i, angle in zip(self._dof + self._held, angles, strict=True):
             pb.resetJointState(self.body, i, float(angle), 0.0, physicsClientId=c)
         low = np.inf
         for link, off, _ in self._soles:
@@ -208,14 +218,15 @@ class BulletPlant:
         self._queue.issue(self._steps, self._cmd)
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
         mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
-        mjj = mass[6 + np.array(self._dof)]  # each joint's own inertia [kg m²]
+        dofs = self._dof + self._held  # the held hinges' servos keep the standing posture
+        mjj = mass[6 + np.array(dofs)]  # each joint's own inertia [kg m²]
         for _ in range(self.substeps):
-            states = pb.getJointStates(self.body, self._dof, physicsClientId=c)
+            states = pb.getJointStates(self.body, dofs, physicsClientId=c)
             q = np.array([s[0] for s in states])
             qd = np.array([s[1] for s in states])
-            target = self._queue.applied(self._steps) * self._sign
+            target = np.r_[self._queue.applied(self._steps) * self._sign, self._held_target]
             tau = self.servo.torque(target, q, qd, mjj).tolist()
-            pb.setJointMotorControlArray(self.body, self._dof, pb.TORQUE_CONTROL, forces=tau, **cid)
+            pb.setJointMotorControlArray(self.body, dofs, pb.TORQUE_CONTROL, forces=tau, **cid)
             if self._kicks < len(opt.pushes):
                 self._kicks, dv = kicks_due(opt.pushes, self.time, self._kicks)
                 if dv.any():  # the whole robot's horizontal velocity, as MuJoCo's kick
@@ -277,7 +288,7 @@ class BulletPlant:
 
     def torques(self) -> np.ndarray:
         """``(n,)`` each servo's output torque over the last physics step [Nm]."""
-        return self.servo.tau * self._sign
+        return self.servo.tau[: len(self._dof)] * self._sign
 
     def torque_limits(self) -> np.ndarray:
         """``(n,)`` each servo's torque limit [Nm]."""

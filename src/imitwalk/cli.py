@@ -12,7 +12,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from imitwalk import commands
+from imitwalk import commands, robot_commands
 from imitwalk.config import RECIPES
 from imitwalk.errors import ImitwalkError
 from imitwalk.protocol import PROTOCOLS
@@ -92,12 +92,17 @@ def build_parser() -> argparse.ArgumentParser:
     info = rsub.add_parser("info", help="joints, limits, mass, height, sensors, rates")
     _robot_args(info)
     info.add_argument("--json", action="store_true", help="print JSON")
-    info.set_defaults(func=commands.robot_info)
+    info.set_defaults(func=robot_commands.robot_info)
     stand = rsub.add_parser("stand", help="hold the standing keyframe; report tilt and forces")
     _robot_args(stand)
     stand.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (10)")
     stand.add_argument("--json", action="store_true", help="print JSON")
-    stand.set_defaults(func=commands.robot_stand)
+    stand.set_defaults(func=robot_commands.robot_stand)
+    imp = rsub.add_parser("import", help="draft a joint map from an MJCF file (never edits it)")
+    imp.add_argument("mjcf", help="the robot's MJCF .xml")
+    imp.add_argument("--out", required=True, help="the joint map to write (.json)")
+    imp.add_argument("--json", action="store_true", help="print JSON")
+    imp.set_defaults(func=robot_commands.robot_import)
 
     rt = sub.add_parser("retarget", help="mocap -> robot joint trajectory (.npz)")
     _mocap_args(rt)

@@ -7,13 +7,24 @@ import json
 import sys
 from pathlib import Path
 
-__all__ = ["emit", "playback", "progress", "retarget", "robot_from", "robot_info", "robot_stand"]
+import numpy as np
+
+__all__ = [
+    "emit",
+    "playback",
+    "progress",
+    "retarget",
+    "robot_from",
+]
 
 
-def emit(obj: dict, as_json: bool) -> None:
-    """Print ``obj`` as JSON, or as aligned ``key: value`` lines."""
+def emit(obj: dict, as_json: bool, finite: bool = False) -> None:
+    """Print ``obj`` as JSON, or as aligned ``key: value`` lines; ``finite``: a NaN or an
+    infinity (a servo without a torque limit) is printed as ``null``, so the JSON is valid."""
+    if finite:
+        obj = _finite(obj)
     if as_json:
-        print(json.dumps(obj, indent=2, default=_plain))
+        print(json.dumps(obj, indent=2, default=_plain, allow_nan=not finite))
         return
     for key, val in obj.items():
         if isinstance(val, dict | list):
@@ -22,6 +33,17 @@ def emit(obj: dict, as_json: bool) -> None:
         elif isinstance(val, float):
             val = f"{val:.4g}"
         print(f"{key:>28}: {val}")
+
+
+def _finite(v):
+    """``v`` with every non-finite float (also in dicts and lists) replaced by ``None``."""
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_finite(x) for x in v]
+    if isinstance(v, float | np.floating) and not np.isfinite(v):
+        return None
+    return v
 
 
 def _plain(v):
@@ -42,54 +64,6 @@ def robot_from(args: argparse.Namespace):
     from imitwalk.robots import load_robot
 
     return load_robot(args.robot, getattr(args, "joint_map", None))
-
-
-def robot_info(args: argparse.Namespace) -> int:
-    from imitwalk.sim import SimOptions
-
-    r = robot_from(args)
-    opt = SimOptions()
-    joints = {
-        n: {
-            "mjcf": j,
-            "min_rad": float(lo),
-            "max_rad": float(hi),
-            "kp_nm_per_rad": float(kp),
-            "torque_limit_nm": float(tl),
-        }
-        for n, j, (lo, hi), kp, tl in zip(
-            r.joint_names, r.mj_joints, r.limits, r.kp, r.torque_limit, strict=True
-        )
-    }
-    emit(
-        {
-            "name": r.name,
-            "mjcf": str(r.mjcf),
-            "dof": r.dof,
-            "joints": joints,
-            "total_mass_kg": r.total_mass,
-            "standing_height_m": r.height,
-            "standing_torso_height_m": r.torso_height,
-            "sensors": {
-                "gyro": r.gyro,
-                "accelerometer": r.accelerometer,
-                "foot_force": {s: list(v) for s, v in r.foot_force.items()},
-                "all": list(r.sensors),
-            },
-            "control_hz": opt.control_hz,
-            "physics_hz": opt.physics_hz,
-        },
-        args.json,
-    )
-    return 0
-
-
-def robot_stand(args: argparse.Namespace) -> int:
-    from imitwalk.standing import stand_test
-
-    res = stand_test(robot_from(args), seconds=args.seconds)
-    emit(res.to_dict(), args.json)
-    return 1 if res.fell else 0
 
 
 def _motion(args: argparse.Namespace):
@@ -121,13 +95,21 @@ def retarget(args: argparse.Namespace) -> int:
     progress(f"  cycles: {res.template.meta['cycles_report']}")
     for row in res.reference.search.get("cadence", {}).get("trials", []):
         progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
-    res.reference.settings["robot"] = args.robot
-    res.reference.settings["joint_map"] = args.joint_map
+    res.reference.settings["robot"] = _where(args.robot)
+    res.reference.settings["joint_map"] = _where(args.joint_map)
     res.reference.save(args.out)
     stats = res.stats()
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
+
+
+def _where(robot: str | None) -> str | None:
+    """A robot as a reference records it: a built-in name as it is, a file as an absolute
+    path (so that the reference plays from any working directory)."""
+    if robot is None or not Path(robot).is_file():
+        return robot
+    return str(Path(robot).resolve())
 
 
 def _announce_search(cfg) -> None:
@@ -233,8 +215,8 @@ def learn(args: argparse.Namespace) -> int:
         res = do_retarget(motion, robot, rcfg, search_report, refine_report)
         progress(f"  cycles: {res.template.meta['cycles_report']}")
         ref = res.reference
-        ref.settings["robot"] = args.robot
-        ref.settings["joint_map"] = args.joint_map
+        ref.settings["robot"] = _where(args.robot)
+        ref.settings["joint_map"] = _where(args.joint_map)
     progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
     keys = (
@@ -266,8 +248,8 @@ def evaluate(args: argparse.Namespace) -> int:
     check_gain(args.gain)
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
-    ref_settings = cfg.get("reference", {})
-    args.robot = args.robot or ref_settings.get("robot") or cfg.get("robot", "hoap2")
+    if args.robot is None:
+        args.robot, args.joint_map = _run_robot(rd, cfg)
     learned_on = cfg.get("learn", {}).get("engine", "mujoco")
     if args.protocol is not None:
         if args.engine is not None:
@@ -288,6 +270,18 @@ def evaluate(args: argparse.Namespace) -> int:
     rd.write_json(_result_name(kind, args, learned_on), out)
     emit(out, args.json)
     return 0
+
+
+def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
+    """The robot a run learned on and its joint map: the file its reference records (a
+    built-in name, or the joint map's path), else the name in its ``config.json``."""
+    from imitwalk.retarget import Reference
+
+    settings = (
+        Reference.load(rd.file("reference.npz")).settings if rd.exists("reference.npz") else {}
+    )
+    name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
+    return name or "hoap2", settings.get("joint_map")
 
 
 def _evaluate_protocol(args: argparse.Namespace, rd, robot) -> int:

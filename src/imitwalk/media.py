@@ -42,8 +42,9 @@ class ReportSettings:
         fps: video frame rate [Hz]; width, height: size of each video half [px].
         strip_frames: images per film-strip row and example poses of Fig. 3.
         strip_width, strip_height: film-strip and pose image size [px].
-        video_camera, strip_camera: (distance [m], azimuth [deg], elevation [deg]); the
-            strips and poses are seen from the side, like the human skeleton.
+        video_camera, strip_camera: (distance [the robot's standing heights], azimuth
+            [deg], elevation [deg]); the strips and poses are seen from the side, like the
+            human skeleton.
     """
 
     fps: float = 25.0
@@ -52,8 +53,8 @@ class ReportSettings:
     strip_frames: int = 6
     strip_width: int = 240
     strip_height: int = 300
-    video_camera: tuple[float, float, float] = (1.2, 120.0, -20.0)
-    strip_camera: tuple[float, float, float] = (0.9, 90.0, -12.0)
+    video_camera: tuple[float, float, float] = (2.5, 120.0, -20.0)
+    strip_camera: tuple[float, float, float] = (1.85, 90.0, -12.0)
 
 
 def gyro_until_fall(ro: Rollout, margin: float = 0.3) -> np.ndarray:

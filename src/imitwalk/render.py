@@ -24,13 +24,19 @@ from imitwalk.robots import Robot
 __all__ = ["Renderer", "render_frames", "save_png", "write_mp4"]
 
 
+#: The camera looks at this fraction of the robot's standing height above the floor.
+LOOK_AT = 0.45
+
+
 class Renderer:
-    """Renders ``qpos`` states of one robot, following its torso with the camera.
+    """Renders ``qpos`` states of one robot (its own meshes and materials), following its
+    torso with the camera.
 
     Args:
         robot: the robot to draw.
         width, height: image size [px].
-        distance: camera distance [m]; azimuth, elevation: [deg].
+        distance: camera distance, in the robot's standing heights (the camera keeps the
+            same framing for a robot of any size); azimuth, elevation: [deg].
     """
 
     def __init__(
@@ -38,11 +44,13 @@ class Renderer:
         robot: Robot,
         width: int = 640,
         height: int = 480,
-        distance: float = 1.1,
+        distance: float = 2.3,
         azimuth: float = 120.0,
         elevation: float = -12.0,
     ):
         self.model = m = robot.compile()
+        self._look = LOOK_AT * robot.height
+        distance = distance * robot.height
         m.vis.quality.offsamples = 0
         m.vis.quality.shadowsize = 0
         m.vis.global_.offwidth = max(width, int(m.vis.global_.offwidth))
@@ -65,7 +73,7 @@ class Renderer:
         self.data.qpos[:] = qpos
         mujoco.mj_forward(self.model, self.data)
         look = self.data.xpos[self._torso].copy()
-        look[2] = 0.22
+        look[2] = self._look
         self._cam.lookat[:] = look
         self._r.update_scene(self.data, camera=self._cam, scene_option=self._opt)
         self._r.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False

@@ -120,7 +120,8 @@ def write_report(
     rd = RunDir(run_dir)
     lg = load_gait(run_dir)
     config = rd.read_json("config.json")
-    robot = robot or load_robot(config.get("robot", lg.ref.robot))
+    where = lg.ref.settings.get("robot") or config.get("robot", lg.ref.robot)  # a file, or a name
+    robot = robot or load_robot(where, lg.ref.settings.get("joint_map"))
     say(f"report: replaying {seconds:g} s at scale {lg.scale:g} (open loop, learned)")
     rp = media.replay(lg, robot, seconds)
 

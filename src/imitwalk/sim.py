@@ -118,6 +118,8 @@ class MujocoPlant:
     def reset(self, q: np.ndarray | None = None) -> Observation:
         m, d, r = self.model, self.data, self.robot
         mujoco.mj_resetData(m, d)
+        if r.stand_ctrl is not None:  # servos of joints without a role hold the posture
+            d.ctrl[:] = r.stand_ctrl
         d.qpos[:] = r.stand_qpos
         if q is not None:
             q = np.asarray(q, dtype=float)
@@ -183,8 +185,9 @@ class MujocoPlant:
         return self.data.actuator_force[self._act] * self._sign
 
     def torque_limits(self) -> np.ndarray:
-        """``(n,)`` each servo's torque limit [Nm] (the larger side of its force range)."""
-        return np.abs(self.model.actuator_forcerange[self._act]).max(axis=1)
+        """``(n,)`` each servo's torque limit [Nm] (:attr:`Robot.torque_limit`: its force
+        range and its joint's, ``inf`` if none)."""
+        return self.robot.torque_limit.copy()
 
     def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Ground truth torso position ``(3,)`` [m] and quaternion ``(4,)`` (w, x, y, z)."""

@@ -24,7 +24,8 @@ class StandResult:
         foot_force_sum_n: sum of all sole force sensors over the last second [N];
         weight_n: the robot's weight, mass × g [N];
         left_n, right_n: force under each sole over the last second [N];
-        both_feet_in_contact: both soles carry load at the end.
+        both_feet_in_contact: both soles carry load at the end;
+        height_lost_m: how much lower the torso is at the end than at the start [m].
     """
 
     fell: bool
@@ -36,10 +37,18 @@ class StandResult:
     left_n: float
     right_n: float
     both_feet_in_contact: bool
+    height_lost_m: float = 0.0
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
         return asdict(self)
+
+    def refusal(self, robot: str) -> str:
+        """One line saying that ``robot`` cannot stand: the height lost and the tilt."""
+        return (
+            f"robot {robot} cannot stand: after {self.seconds:g} s the torso lost "
+            f"{self.height_lost_m:.3f} m of height and tilted {self.final_tilt_deg:.0f} deg"
+        )
 
 
 def _root(plant: MujocoPlant) -> int:
@@ -68,4 +77,5 @@ def stand_test(
         left_n=float(per_side[0]),
         right_n=float(per_side[1]),
         both_feet_in_contact=bool((per_side > 0.05 * per_side.sum()).all()),
+        height_lost_m=float(ro.torso_pos[0, 2] - ro.torso_pos[-1, 2]),
     )

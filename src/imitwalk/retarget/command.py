@@ -29,20 +29,52 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["PATH_COLUMNS", "GaitCommand", "advance", "cycle_motion", "place", "walking_frame"]
+__all__ = [
+    "PATH_COLUMNS",
+    "GaitCommand",
+    "advance",
+    "check_side",
+    "cycle_motion",
+    "place",
+    "walking_frame",
+]
 
 #: Columns of a plan's ``path`` array: the walking frame's position x, y [m] and heading
 #: [rad] on the ground, and the forward and sideways travel commanded so far [m]
 #: (measured in the walking frame, so a turn's forward travel is its arc length).
 PATH_COLUMNS = ("x", "y", "heading", "forward", "side")
 
-#: Allowed ranges of the command's fields.
+#: Allowed ranges of the command's fields. The sidestep's is for a leg of
+#: :data:`~imitwalk.retarget.params.REFERENCE_LEG`: a robot's own is scaled by its leg
+#: (:func:`check_side`, when the plan is laid out).
 LIMITS = {
     "turn_deg": (-30.0, 30.0),
     "side_m": (-0.05, 0.05),
     "forward": (0.0, 1.5),
     "slope_deg": (-10.0, 10.0),
 }
+
+
+#: A command is built before the robot is known: its sidestep may be this many times
+#: :data:`LIMITS`' (a robot up to this many times hoap2's leg); :func:`check_side` then
+#: holds it to the robot's own.
+SIDE_SLACK = 10.0
+
+
+def check_side(command: GaitCommand, leg: float) -> None:
+    """Refuse a sidestep beyond :data:`LIMITS`' scaled to a robot whose leg is ``leg`` [m].
+
+    Raises:
+        ConfigError: ``|side_m|`` is larger (the message gives this robot's range).
+    """
+    from imitwalk.retarget.params import leg_scaled
+
+    lo, hi = (leg_scaled(x, leg) for x in LIMITS["side_m"])
+    if not lo <= command.side_m <= hi:
+        raise ConfigError(
+            f"command side_m={command.side_m}: expected {lo:g} <= side_m <= {hi:g} "
+            "(scaled with this robot's leg)"
+        )
 
 
 @dataclass(frozen=True)
@@ -73,6 +105,8 @@ class GaitCommand:
     def __post_init__(self):
         for name, (lo, hi) in LIMITS.items():
             v = getattr(self, name)
+            if name == "side_m":  # scaled with the robot's leg: checked by check_side
+                lo, hi = lo * SIDE_SLACK, hi * SIDE_SLACK
             if not (np.isfinite(v) and lo <= v <= hi):
                 raise ConfigError(f"command {name}={v}: expected {lo:g} <= {name} <= {hi:g}")
 

@@ -20,6 +20,7 @@ import numpy as np
 from imitwalk.errors import RetargetError
 from imitwalk.retarget.plan import LegGeometry, TaskPlan
 from imitwalk.robots import Robot
+from imitwalk.robots.tree import Tree, footprint
 from imitwalk.stepconfig import TASK_OFFSETS
 
 __all__ = ["CHANNELS", "IKResult", "WalkIK", "leg_geometry"]
@@ -47,7 +48,11 @@ def _mat(model, data, name: str) -> np.ndarray:
 
 def leg_geometry(robot: Robot) -> LegGeometry:
     """Measure the left leg of ``robot`` at zero joint angles (pelvis frame), and how far
-    the hips stand ahead of the centre of mass in the standing posture."""
+    the hips stand ahead of the centre of mass in the standing posture.
+
+    The hip point is the hip-pitch axis's anchor moved sideways over the ankle (on a
+    robot whose hip axes do not meet above the leg, e.g. G1, the pitch hinge sits inside
+    the leg's line); the foot's size is the footprint of its collision geoms."""
     m = robot.compile()
     d = mujoco.MjData(m)
     d.qpos[:] = robot.stand_qpos
@@ -61,20 +66,19 @@ def leg_geometry(robot: Robot) -> LegGeometry:
     root = int(m.body_rootid[m.body(robot.torso).id])
     pelvis = d.xpos[root]
     anchor = lambda role: d.xanchor[m.joint(robot.mj_joints[robot.index(role)]).id]  # noqa: E731
-    hip, ankle = anchor("l_hip_pitch"), anchor("l_ankle_pitch")
+    hip, ankle = anchor("l_hip_pitch").copy(), anchor("l_ankle_pitch")
+    hip[1] = ankle[1]  # the hip point over the ankle: hip axes need not meet above the leg
     sole = _pos(m, d, robot.soles["l"])
-    foot_body = m.body(_body_of(m, robot.soles["l"])).id
-    boxes = [2 * m.geom_aabb[g, 3:5] for g in range(m.ngeom) if m.geom_bodyid[g] == foot_body]
-    lengths, widths = zip(*boxes, strict=True) if boxes else ([0.1], [0.0])
+    foot = footprint(m, d, Tree(m).subtree(m.body(_body_of(m, robot.soles["l"])).id))
     return LegGeometry(
         hip_y=float(abs(hip[1] - pelvis[1])),
         hip_z=float(pelvis[2] - hip[2]),
         leg=float(np.linalg.norm(hip - ankle)),
         ankle=float(ankle[2] - sole[2]),
         sole_x=float(sole[0] - ankle[0]),
-        foot_length=float(max(lengths)),
+        foot_length=float(2 * foot.half[0]),
         hip_ahead=hip_ahead,
-        foot_width=float(max(widths)),
+        foot_width=float(2 * foot.half[1]),
     )
 
 
@@ -118,6 +122,11 @@ class WalkIK:
     ):
         self.robot, self.tol, self.max_iter = robot, tol, max_iter
         self.model = m = robot.compile()
+        for (lo, hi), name, sign in zip(robot.limits, robot.mj_joints, robot.signs, strict=True):
+            j = m.joint(name).id
+            if not m.jnt_limited[j]:  # a joint without a range: its servo's (Robot.limits)
+                m.jnt_limited[j] = 1
+                m.jnt_range[j] = np.sort(np.array([lo, hi]) * sign)
         # the knees may not straighten past ``knee_floor_deg`` in the IK: where a foot is
         # out of reach the (softer) pelvis-height task gives way instead of the knee
         for s in ("l_knee", "r_knee"):

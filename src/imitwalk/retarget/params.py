@@ -8,9 +8,25 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
-__all__ = ["GaitParams", "LegGeometry"]
+__all__ = ["LIFT", "REFERENCE_LEG", "GaitParams", "LegGeometry", "leg_scaled"]
+
+#: The leg (hip to ankle) [m] that every length in the reference's tables is written
+#: for: the default lift below, the search ranges (:data:`imitwalk.retarget.search.BOUNDS`),
+#: the refinement's nudges and the least gap between the feet. They were set on hoap2,
+#: whose leg this is; a robot with another leg has them scaled by its own over this one
+#: (:func:`leg_scaled`), so a robot three times as tall lifts its feet three times as high.
+REFERENCE_LEG = 0.2
+#: The default swing-foot clearance at :data:`REFERENCE_LEG` [m] (a tenth of the leg).
+LIFT = 0.02
+
+
+def leg_scaled(x: float, leg: float | None) -> float:
+    """A length ``x`` [m] written for :data:`REFERENCE_LEG`, for a robot whose leg is
+    ``leg`` [m] (``None``: as written); rounded to the micrometre, so that a leg of
+    :data:`REFERENCE_LEG` gives back ``x`` exactly."""
+    return x if leg is None else round(x * leg / REFERENCE_LEG, 6) + 0.0
 
 
 @dataclass(frozen=True)
@@ -20,7 +36,8 @@ class GaitParams:
     Attributes:
         sway: lateral CoM amplitude ÷ the lateral offset of the feet (about 0.9 worked).
         height: hip height ÷ the straight-leg hip height (knee stays bent below 1).
-        lift: swing foot clearance at its peak [m].
+        lift: swing foot clearance at its peak [m]; ``None``: :data:`LIFT` scaled to the
+            robot's leg (:meth:`for_leg`), a tenth of it.
         ds: double-support fraction of the cycle, per transition (about 0.1 worked).
         lean: centre of mass ahead of the feet's midpoint [m]; a compliant robot sags
             backwards under its own weight, so a few millimetres may be needed.
@@ -29,7 +46,7 @@ class GaitParams:
 
     sway: float = 0.9
     height: float = 0.9
-    lift: float = 0.02
+    lift: float | None = None
     ds: float = 0.1
     lean: float = 0.0
     width: float = 0.0
@@ -37,6 +54,11 @@ class GaitParams:
     def to_dict(self) -> dict:
         """Plain dictionary."""
         return asdict(self)
+
+    def for_leg(self, leg: float | None) -> GaitParams:
+        """These parameters with a ``None`` lift set for a leg of ``leg`` [m] (``None``:
+        :data:`REFERENCE_LEG`)."""
+        return self if self.lift is not None else replace(self, lift=leg_scaled(LIFT, leg))
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,9 @@ import numpy as np
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.mocap.motion import Motion
 from imitwalk.retarget.cadence import with_cadence
-from imitwalk.retarget.command import GaitCommand
+from imitwalk.retarget.command import GaitCommand, check_side
 from imitwalk.retarget.human import build_paper
+from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.refine import refine_params, refine_per_scale
@@ -161,13 +162,16 @@ def retarget(
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
         report = {}
     else:
-        params, report, own = cfg.params, {}, None
+        leg = leg_geometry(robot).leg
+        check_side(cfg.command, leg)  # before any search: the sidestep scales with the leg
+        # a lift left unset is a tenth of this robot's leg
+        params, report, own = cfg.params.for_leg(leg), {}, None
         if cfg.search:
             params, report = search_params(
                 template,
                 robot,
                 cfg.search_config,
-                cfg.params,
+                params,
                 dt,
                 progress=progress,
                 command=cfg.command,

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.errors import ConfigError
-from imitwalk.retarget.command import GaitCommand, cycle_motion, place, walking_frame
-from imitwalk.retarget.params import GaitParams, LegGeometry
+from imitwalk.retarget.command import GaitCommand, check_side, cycle_motion, place, walking_frame
+from imitwalk.retarget.params import GaitParams, LegGeometry, leg_scaled
 from imitwalk.retarget.template import GaitTemplate
 
 __all__ = [
@@ -47,7 +47,8 @@ __all__ = [
     "plan_walk",
 ]
 
-#: Least gap between the soles' edges when a sidestep's closing step lands [m].
+#: Least gap between the soles' edges when a sidestep's closing step lands [m], for a leg of
+#: :data:`~imitwalk.retarget.params.REFERENCE_LEG` (scaled with the robot's leg).
 FOOT_GAP = 0.01
 
 #: Start-up cycles: one of sway with both feet down, then two of growing stride.
@@ -134,6 +135,8 @@ def plan_walk(
         ConfigError: a turn or sidestep without ``start``.
     """
     cmd = command or GaitCommand()
+    params = params.for_leg(geom.leg)
+    check_side(cmd, geom.leg)
     n_cyc = max(2, round(template.period / dt))
     period = n_cyc * dt
     stride = cmd.forward * scale * template.stride * geom.leg / template.leg_length
@@ -143,7 +146,7 @@ def plan_walk(
     y_foot = geom.hip_y + params.width
     if cmd.side_m:
         side = abs(cmd.side_m * scale)
-        y_foot = max(y_foot, (geom.foot_width + FOOT_GAP + side / 2) / 2)
+        y_foot = max(y_foot, (geom.foot_width + leg_scaled(FOOT_GAP, geom.leg) + side / 2) / 2)
     if not start and (cmd.turn_deg or cmd.side_m):
         raise ConfigError("a turning or sidestepping plan needs start=True")
     ramp = START_CYCLES if start else 0

@@ -45,9 +45,9 @@ import numpy as np
 
 from imitwalk.perturb import train_seeds
 from imitwalk.retarget.command import GaitCommand
-from imitwalk.retarget.ik import WalkIK
-from imitwalk.retarget.params import GaitParams
-from imitwalk.retarget.search import BOUNDS
+from imitwalk.retarget.ik import WalkIK, leg_geometry
+from imitwalk.retarget.params import GaitParams, leg_scaled
+from imitwalk.retarget.search import LENGTHS, bounds
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
@@ -55,7 +55,9 @@ from imitwalk.simtypes import SimOptions
 
 __all__ = ["PROGRESS_SLACK", "STEPS", "RefineTrial", "refine_params", "refine_per_scale"]
 
-#: How far one nudge moves each parameter (its units: see :class:`GaitParams`).
+#: How far one nudge moves each parameter (its units: see :class:`GaitParams`); the lengths'
+#: nudges are for a leg of :data:`~imitwalk.retarget.params.REFERENCE_LEG` and scale with
+#: the robot's (as :func:`~imitwalk.retarget.search.bounds` does).
 STEPS: dict[str, float] = {
     "sway": 0.025,
     "height": 0.01,
@@ -142,6 +144,9 @@ def refine_params(
 
     scales = [at] if at is not None else sorted(config.refine_scales)
     seeds = train_seeds(config.refine_models)
+    leg = leg_geometry(robot).leg if robot is not None else None
+    box = bounds(leg)
+    steps = {k: leg_scaled(v, leg) if k in LENGTHS else v for k, v in STEPS.items()}
     ik = WalkIK(robot)
     names = [f.name for f in fields(GaitParams)]
     total = 1 + config.refine_rounds * 2 * len(names)
@@ -205,10 +210,11 @@ def refine_params(
         for name in names:
             if best.falls == 0:
                 break  # nothing can beat a set that never falls (it is up the whole time)
-            lo, hi = BOUNDS[name]
+            lo, hi = box[name]
+            value = getattr(current.for_leg(leg), name)  # an unset lift: the robot's default
             for sign, tag in ((1.0, "+"), (-1.0, "-")):
-                x = float(np.clip(getattr(current, name) + sign * STEPS[name], lo, hi))
-                if abs(x - getattr(current, name)) < 1e-12:
+                x = float(np.clip(value + sign * steps[name], lo, hi))
+                if abs(x - value) < 1e-12:
                     continue  # at its bound
                 cand = replace(current, **{name: x})
                 t = trial(cand, name + tag, best.falls if config.refine_early_stop else None)
@@ -228,7 +234,7 @@ def refine_params(
         "scales": scales,
         "seconds": config.refine_seconds,
         "seeds": list(seeds),
-        "steps": STEPS,
+        "steps": steps,
         "progress_slack": PROGRESS_SLACK,
         "yaw_slack_deg": config.refine_yaw_slack,
         "early_stop": config.refine_early_stop,

@@ -26,7 +26,8 @@ from imitwalk.parallel import run_parallel
 from imitwalk.perturb import perturbed, train_seeds
 from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand
-from imitwalk.retarget.ik import WalkIK
+from imitwalk.retarget.ik import WalkIK, leg_geometry
+from imitwalk.retarget.params import leg_scaled
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.template import GaitTemplate
@@ -35,9 +36,10 @@ from imitwalk.robots import Robot
 from imitwalk.sim import SimOptions, make_plant, playback
 from imitwalk.simtypes import ENGINES
 
-__all__ = ["BOUNDS", "SearchConfig", "search_cadence", "search_params"]
+__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "bounds", "search_cadence", "search_params"]
 
-#: Search range of each reference parameter.
+#: Search range of each reference parameter; the ranges of the lengths (:data:`LENGTHS`)
+#: are for a leg of :data:`~imitwalk.retarget.params.REFERENCE_LEG` (:func:`bounds`).
 BOUNDS: dict[str, tuple[float, float]] = {
     "sway": (0.4, 1.1),
     "height": (0.80, 0.98),
@@ -46,6 +48,16 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "lean": (-0.005, 0.02),
     "width": (0.0, 0.015),
 }
+#: The parameters that are lengths [m]: their ranges scale with the robot's leg.
+LENGTHS = ("lift", "lean", "width")
+
+
+def bounds(leg: float | None) -> dict[str, tuple[float, float]]:
+    """:data:`BOUNDS` for a robot whose leg (hip to ankle) is ``leg`` [m] (``None``: as
+    written, for :data:`~imitwalk.retarget.params.REFERENCE_LEG`)."""
+    return {
+        k: tuple(leg_scaled(x, leg) for x in v) if k in LENGTHS else v for k, v in BOUNDS.items()
+    }
 
 
 @dataclass(frozen=True)
@@ -176,9 +188,11 @@ def search_params(
     """
     cfg = config or SearchConfig()
     names = [f.name for f in fields(GaitParams)]
-    lo = np.array([BOUNDS[n][0] for n in names])
-    hi = np.array([BOUNDS[n][1] for n in names])
-    x0 = np.array([getattr(start or GaitParams(), n) for n in names])
+    leg = leg_geometry(robot).leg
+    box = bounds(leg)  # the lengths' ranges scale with the leg
+    lo = np.array([box[n][0] for n in names])
+    hi = np.array([box[n][1] for n in names])
+    x0 = np.array([getattr((start or GaitParams()).for_leg(leg), n) for n in names])
     mu = np.clip((x0 - lo) / (hi - lo), 0.0, 1.0)
     sd = np.full(len(names), 0.25)
     rng = np.random.default_rng(cfg.seed)
@@ -208,7 +222,7 @@ def search_params(
     report = {
         "method": "cross-entropy method over open-loop rollouts",
         "config": asdict(replace(cfg, workers=None)),
-        "bounds": BOUNDS,
+        "bounds": box,
         "score": "alive fraction + 0.5*min(progress,1) - 0.5*min(|yaw|/45deg,1), mean over runs",
         "evaluations": len(history),
         "sim_seconds": len(history) * per,

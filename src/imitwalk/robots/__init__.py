@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from imitwalk.errors import RobotError, unknown_name
-from imitwalk.robots.spec import ARM_ROLES, LEG_ROLES, ROLES, TRUNK_ROLES, Robot, load_joint_map
+from imitwalk.robots.jointmap import load_joint_map, parse_joint_map
+from imitwalk.robots.spec import ARM_ROLES, LEG_ROLES, ROLES, TRUNK_ROLES, Robot
 
 __all__ = [
     "ARM_ROLES",
@@ -42,16 +43,16 @@ def load_robot(robot: str | Path, joint_map: str | Path | None = None) -> Robot:
     name = str(robot)
     if name in BUILTIN and joint_map is None:
         path = BUILTIN[name]
-        spec = Robot.from_map(load_joint_map(path), path.parent)
+        spec = Robot.from_map(_read(path), path.parent)
     else:
         path = Path(name)
         if path.suffix.lower() == ".json" and joint_map is None:
-            spec = Robot.from_map(load_joint_map(path), path.parent)
+            spec = Robot.from_map(_read(path), path.parent)
         elif path.suffix.lower() == ".xml":
             if joint_map is None:
                 raise RobotError(f"{path} needs a joint map (--joint-map FILE.json)")
             jm = Path(joint_map)
-            spec = Robot.from_map(load_joint_map(jm), jm.parent, mjcf=path)
+            spec = Robot.from_map(_read(jm), jm.parent, mjcf=path)
         elif not path.exists() and path.suffix == "":
             raise unknown_name("robot", name, BUILTIN)
         else:
@@ -60,3 +61,8 @@ def load_robot(robot: str | Path, joint_map: str | Path | None = None) -> Robot:
             )
     _CACHE[key] = spec
     return spec
+
+
+def _read(path: Path):
+    """The joint map at ``path``, checked (:func:`parse_joint_map`)."""
+    return parse_joint_map(load_joint_map(path), str(path))

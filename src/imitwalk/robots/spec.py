@@ -1,14 +1,16 @@
 """Robot description: which MJCF joints play which role, and which sensors to read.
 
-A robot is an MJCF file plus a *joint map* (JSON) naming, for each canonical role
-in :data:`ROLES`, the model's hinge joint that plays it; the gyro (required), the
-accelerometer, the foot force sensors, the torso body and the two sole frames.
-The built-in ``hoap2`` is loaded through exactly the same path as a user's robot.
+A robot is an MJCF file plus a *joint map* (JSON, :mod:`imitwalk.robots.jointmap`) naming,
+for each canonical role in :data:`ROLES`, the model's hinge joint that plays it; the
+gyro, the accelerometer, the foot force sensors, the torso body and the two soles. What
+the file lacks (a floor, sole sites and sensors, an IMU, position servos) is added when
+the model is built (:mod:`imitwalk.robots.build`); the file itself is never changed. The
+built-in ``hoap2`` is loaded through exactly the same path as a user's robot.
 """
 
 from __future__ import annotations
 
-import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,6 +18,10 @@ import mujoco
 import numpy as np
 
 from imitwalk.errors import RobotError, unknown_name
+from imitwalk.robots.assemble import plan_additions
+from imitwalk.robots.build import Additions, compile_model
+from imitwalk.robots.jointmap import JointMap, load_joint_map, parse_joint_map
+from imitwalk.robots.servos import actuator_kind, torque_limit
 
 __all__ = ["ARM_ROLES", "LEG_ROLES", "ROLES", "TRUNK_ROLES", "Robot", "load_joint_map"]
 
@@ -31,47 +37,9 @@ TRUNK_ROLES: tuple[str, ...] = ("waist_yaw", "neck_yaw", "neck_pitch")
 #: Every canonical role, in the order trajectories use.
 ROLES: tuple[str, ...] = LEG_ROLES + ARM_ROLES + TRUNK_ROLES
 
-_MAP_KEYS = (
-    "name",
-    "mjcf",
-    "joints",
-    "gyro",
-    "accelerometer",
-    "foot_force",
-    "torso",
-    "soles",
-    "stand_keyframe",
-    "stand",
-)
-
-
-def load_joint_map(path: str | Path) -> dict:
-    """Read a joint-map JSON file; one-line :class:`RobotError` if it is not valid JSON."""
-    path = Path(path)
-    if not path.is_file():
-        raise RobotError(f"joint map not found: {path}")
-    try:
-        data = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise RobotError(
-            f"joint map {path} is not valid JSON: {exc.msg} (line {exc.lineno})"
-        ) from None
-    if not isinstance(data, dict):
-        raise RobotError(f"joint map {path} must be a JSON object")
-    for key in data:
-        if key not in _MAP_KEYS:
-            raise unknown_name("joint-map key", key, _MAP_KEYS)
-    return data
-
-
-def _compile(mjcf: Path) -> mujoco.MjModel:
-    if not mjcf.is_file():
-        raise RobotError(f"robot file not found: {mjcf}")
-    try:
-        return mujoco.MjModel.from_xml_path(str(mjcf))
-    except ValueError as exc:
-        first = " ".join(str(exc).split())
-        raise RobotError(f"{mjcf} is not valid MJCF: {first}") from None
+#: A standing posture that is not the file's own keyframe is lowered onto the floor: its
+#: lowest sole this far above it [m] (as :meth:`imitwalk.sim.MujocoPlant.reset` does).
+SOLE_CLEARANCE = 1e-4
 
 
 def _names(model: mujoco.MjModel, objtype: mujoco.mjtObj, count: int) -> list[str]:
@@ -94,10 +62,14 @@ class Robot:
         soles: ``{"l": name, "r": name}`` site (or body) at the centre of each sole.
         stand: ``(n,)`` standing posture [rad], canonical signs.
         stand_qpos: full ``qpos`` of the standing keyframe (free base included).
-        limits: ``(n, 2)`` joint ranges [rad], canonical signs.
-        kp: ``(n,)`` servo stiffness [Nm/rad]; torque_limit: ``(n,)`` [Nm].
+        limits: ``(n, 2)`` joint ranges [rad], canonical signs (a joint without a range:
+            its servo's control range, else ±π).
+        kp: ``(n,)`` servo stiffness [Nm/rad]; torque_limit: ``(n,)`` [Nm] (``inf``: none).
         total_mass: [kg]; torso_height: torso body height when standing [m];
         height: top of the model above the soles when standing [m].
+        additions: what building the model adds to the file (:mod:`imitwalk.robots.build`).
+        stand_ctrl: ``(nu,)`` every actuator's control in the standing posture (position
+            servos hold their joint's angle), ``None``: zeros.
     """
 
     name: str
@@ -119,6 +91,8 @@ class Robot:
     torso_height: float
     height: float
     sensors: tuple[str, ...] = field(default=())
+    additions: Additions = field(default_factory=Additions)
+    stand_ctrl: np.ndarray | None = None
 
     @property
     def dof(self) -> int:
@@ -137,145 +111,105 @@ class Robot:
         return np.array([self.index(r) for r in roles], dtype=int)
 
     def compile(self) -> mujoco.MjModel:
-        """A fresh :class:`mujoco.MjModel` of this robot (callers may modify it)."""
-        return _compile(self.mjcf)
+        """A fresh :class:`mujoco.MjModel` of this robot (callers may modify it): the
+        MJCF with :attr:`additions`."""
+        return compile_model(self.mjcf, self.additions)
 
     def clip(self, q: np.ndarray) -> np.ndarray:
         """Clip ``(..., n)`` joint angles to the joint ranges [rad]."""
         return np.clip(q, self.limits[:, 0], self.limits[:, 1])
 
     @classmethod
-    def from_map(cls, jmap: dict, base: Path, mjcf: Path | None = None) -> Robot:
+    def from_map(cls, jmap: dict | JointMap, base: Path, mjcf: Path | None = None) -> Robot:
         """Validate a joint map against its MJCF and build the record.
 
         Args:
-            jmap: parsed joint map (see :func:`load_joint_map`).
+            jmap: parsed joint map (see :func:`load_joint_map`), or a checked one.
             base: folder that relative paths in the map are resolved against.
             mjcf: the MJCF file; defaults to the map's ``"mjcf"`` entry.
         """
+        jm = jmap if isinstance(jmap, JointMap) else parse_joint_map(jmap)
         if mjcf is None:
-            if "mjcf" not in jmap:
+            if jm.mjcf is None:
                 raise RobotError("joint map names no 'mjcf' file and none was given")
-            mjcf = base / jmap["mjcf"]
+            mjcf = Path(os.path.normpath(Path(base) / jm.mjcf))
         mjcf = Path(mjcf)
-        model = _compile(mjcf)
-        return _build(cls, jmap, mjcf, model)
+        add, res = plan_additions(jm, compile_model(mjcf), mjcf)
+        model = compile_model(mjcf, add)
+        return _build(cls, jm, res, mjcf, model, add)
 
 
-def _build(cls: type[Robot], jmap: dict, mjcf: Path, model: mujoco.MjModel) -> Robot:
-    joints_all = _names(model, mujoco.mjtObj.mjOBJ_JOINT, model.njnt)
-    sensors_all = _names(model, mujoco.mjtObj.mjOBJ_SENSOR, model.nsensor)
-    bodies = _names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody)
-    sites = _names(model, mujoco.mjtObj.mjOBJ_SITE, model.nsite)
-
-    jm = jmap.get("joints")
-    if not isinstance(jm, dict) or not jm:
-        raise RobotError("joint map has no 'joints' object (role -> MJCF joint name)")
-    for role in jm:
-        if role not in ROLES:
-            raise unknown_name("joint role", role, ROLES)
-    missing = [r for r in LEG_ROLES if r not in jm]
-    if missing:
-        raise RobotError(f"joint map lacks leg roles: {', '.join(missing)}")
-    roles = tuple(r for r in ROLES if r in jm)
-    mj_joints, signs = [], []
-    for role in roles:
-        entry = jm[role]
-        name, sign = (
-            (entry, 1.0) if isinstance(entry, str) else (entry.get("joint"), entry.get("sign", 1.0))
-        )
-        if name not in joints_all:
-            raise unknown_name("joint", str(name), [j for j in joints_all if j])
-        jid = model.joint(name).id
-        if model.jnt_type[jid] != mujoco.mjtJoint.mjJNT_HINGE:
-            raise RobotError(f"joint {name!r} (role {role}) is not a hinge joint")
-        if sign not in (1, -1, 1.0, -1.0):
-            raise RobotError(f"sign of role {role} must be 1 or -1, got {sign!r}")
-        mj_joints.append(name)
-        signs.append(float(sign))
-    signs_a = np.array(signs)
-
-    gyro = jmap.get("gyro")
-    gyros = [
-        s for i, s in enumerate(sensors_all) if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_GYRO
-    ]
-    if not gyros:
-        raise RobotError(f"{mjcf.name} has no gyro sensor; add <gyro site=.../> on the torso")
-    if gyro is None:
-        raise RobotError(
-            f"joint map names no 'gyro'; gyro sensors in the model: {', '.join(gyros)}"
-        )
-    if gyro not in gyros:
-        raise unknown_name("gyro sensor", str(gyro), gyros)
-    accel = jmap.get("accelerometer")
-    if accel is not None and accel not in sensors_all:
-        raise unknown_name("sensor", str(accel), sensors_all)
-    ff = {s: tuple(jmap.get("foot_force", {}).get(s, ())) for s in _SIDES}
-    for name in ff["l"] + ff["r"]:
-        if name not in sensors_all:
-            raise unknown_name("sensor", name, sensors_all)
-    torso = jmap.get("torso")
-    if torso not in bodies:
-        raise unknown_name("torso body", str(torso), [b for b in bodies if b])
-    soles = jmap.get("soles", {})
-    for s in _SIDES:
-        if soles.get(s) not in sites and soles.get(s) not in bodies:
-            raise unknown_name(f"{s} sole site", str(soles.get(s)), [x for x in sites if x])
-
+def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Additions) -> Robot:
+    roles, mj_joints, signs = res.roles, res.joints, np.array(res.signs)
     data = mujoco.MjData(model)
-    key = jmap.get("stand_keyframe")
+    key = jm.stand_keyframe
     if key is not None:
         keys = _names(model, mujoco.mjtObj.mjOBJ_KEY, model.nkey)
         if key not in keys:
-            raise unknown_name("keyframe", str(key), keys)
+            raise unknown_name("keyframe", key, keys)
         mujoco.mj_resetDataKeyframe(model, data, model.key(key).id)
-    adr = np.array([model.jnt_qposadr[model.joint(j).id] for j in mj_joints])
-    if "stand" in jmap:
-        for role, val in jmap["stand"].items():
-            data.qpos[adr[roles.index(role) if role in roles else _bad_role(role, roles)]] = (
-                float(val) * signs_a[roles.index(role)]
-            )
+    jid = np.array([model.joint(j).id for j in mj_joints])
+    adr = model.jnt_qposadr[jid]
+    for role, val in jm.stand.items():
+        data.qpos[adr[roles.index(role)]] = val * signs[roles.index(role)]
+    mujoco.mj_kinematics(model, data)
+    if key is None or jm.stand:  # not the file's own posture: put it on the floor
+        low = min(_frame_pos(model, data, res.soles[s])[2] for s in _SIDES)
+        data.qpos[2] -= low - SOLE_CLEARANCE
     mujoco.mj_forward(model, data)
-    ranges = np.array([model.jnt_range[model.joint(j).id] for j in mj_joints])
-    limits = np.sort(ranges * signs_a[:, None], axis=1)
-    act_for = {int(model.actuator_trnid[a, 0]): a for a in range(model.nu)}
-    kp, tl = [], []
-    for j in mj_joints:
-        a = act_for.get(model.joint(j).id)
-        if a is None:
-            raise RobotError(
-                f"joint {j!r} has no actuator; imitwalk needs a position servo per joint"
-            )
+    if not np.isfinite(data.qpos).all() or not np.isfinite(data.xpos).all():
+        raise RobotError(f"{mjcf.name}: the standing posture is not finite")
+    acts = {
+        int(model.actuator_trnid[a, 0]): a
+        for a in range(model.nu)
+        if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+    }
+    kp, tl, ranges = [], [], []
+    for name, j in zip(mj_joints, jid, strict=True):
+        a = acts.get(int(j))
+        if a is None or actuator_kind(model, a) != "position":
+            raise RobotError(f"joint {name!r} has no position servo; imitwalk needs one per joint")
         kp.append(float(model.actuator_gainprm[a, 0]))
-        lim = model.actuator_forcerange[a]
-        tl.append(float(lim[1]) if model.actuator_forcelimited[a] else float("inf"))
-    root = int(model.body_rootid[model.body(torso).id])
-    sole_z = min(_frame_pos(model, data, soles[s])[2] for s in _SIDES)
+        tl.append(torque_limit(model, a, int(j)))
+        if model.jnt_limited[j]:
+            ranges.append(model.jnt_range[j])
+        elif model.actuator_ctrllimited[a]:
+            ranges.append(model.actuator_ctrlrange[a])
+        else:
+            ranges.append((-np.pi, np.pi))
+    limits = np.sort(np.array(ranges, dtype=float) * signs[:, None], axis=1)
+    ctrl = np.zeros(model.nu)
+    for j, a in acts.items():
+        if actuator_kind(model, a) == "position":
+            lo, hi = (
+                model.actuator_ctrlrange[a] if model.actuator_ctrllimited[a] else (-np.inf, np.inf)
+            )
+            ctrl[a] = np.clip(data.qpos[model.jnt_qposadr[j]], lo, hi)
+    root = int(model.body_rootid[model.body(res.torso).id])
+    sole_z = min(_frame_pos(model, data, res.soles[s])[2] for s in _SIDES)
     return cls(
-        name=str(jmap.get("name", mjcf.stem)),
+        name=jm.name or mjcf.stem,
         mjcf=mjcf,
         joint_names=roles,
         mj_joints=tuple(mj_joints),
-        signs=signs_a,
-        gyro=gyro,
-        accelerometer=accel,
-        foot_force=ff,
-        torso=torso,
-        soles={s: soles[s] for s in _SIDES},
-        stand=data.qpos[adr] * signs_a,
+        signs=signs,
+        gyro=res.gyro,
+        accelerometer=res.accelerometer,
+        foot_force=res.foot_force,
+        torso=res.torso,
+        soles=res.soles,
+        stand=data.qpos[adr] * signs,
         stand_qpos=data.qpos.copy(),
         limits=limits,
         kp=np.array(kp),
         torque_limit=np.array(tl),
         total_mass=float(model.body_subtreemass[root]),
-        torso_height=float(data.xpos[model.body(torso).id][2] - sole_z),
+        torso_height=float(data.xpos[model.body(res.torso).id][2] - sole_z),
         height=_top(model, data) - sole_z,
-        sensors=tuple(s for s in sensors_all if s),
+        sensors=tuple(s for s in _names(model, mujoco.mjtObj.mjOBJ_SENSOR, model.nsensor) if s),
+        additions=add,
+        stand_ctrl=ctrl,
     )
-
-
-def _bad_role(role: str, roles: tuple[str, ...]) -> int:
-    raise unknown_name("joint role in 'stand'", role, roles)
 
 
 def _frame_pos(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:

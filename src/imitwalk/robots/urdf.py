@@ -13,7 +13,7 @@ a joint are fixed to their parent; the free-floating root is the URDF's base lin
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -27,6 +27,7 @@ __all__ = ["NOT_CARRIED", "UrdfRobot", "to_urdf", "urdf_file"]
 
 #: MuJoCo features of the robot model that the URDF (and so Bullet) does not get.
 NOT_CARRIED = (
+    "visual meshes (collision meshes are carried, as the convex hulls MuJoCo collides)",
     "joint armature (rotor inertia)",
     "joint friction loss",
     "position servos (BulletPlant adds them as torque-controlled PD servos)",
@@ -47,6 +48,8 @@ class UrdfRobot:
         joint_links: for each of the robot's ``n`` roles, the link its hinge moves.
         friction: ``(nbody,)`` sliding friction of each body's geoms (MuJoCo's first
             coefficient, the largest of the body's geoms; 0 without geoms).
+        meshes: file name -> OBJ text of each collision mesh the URDF refers to (written
+            next to it).
     """
 
     text: str
@@ -54,6 +57,7 @@ class UrdfRobot:
     base: str
     joint_links: tuple[str, ...]
     friction: np.ndarray
+    meshes: dict[str, str] = field(default_factory=dict)
 
 
 def _v(x) -> str:
@@ -73,7 +77,7 @@ def _rpy(quat: np.ndarray) -> np.ndarray:
     return np.array([roll, pitch, yaw])
 
 
-def _geom(m: mujoco.MjModel, g: int, shift: np.ndarray) -> str | None:
+def _geom(m: mujoco.MjModel, g: int, shift: np.ndarray, meshes: dict | None) -> str | None:
     size = m.geom_size[g]
     kind = m.geom_type[g]
     if kind == mujoco.mjtGeom.mjGEOM_BOX:
@@ -84,6 +88,10 @@ def _geom(m: mujoco.MjModel, g: int, shift: np.ndarray) -> str | None:
         shape = f'<capsule radius="{size[0]:.9g}" length="{2 * size[1]:.9g}"/>'
     elif kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
         shape = f'<cylinder radius="{size[0]:.9g}" length="{2 * size[1]:.9g}"/>'
+    elif kind == mujoco.mjtGeom.mjGEOM_MESH and meshes is not None:
+        mid = int(m.geom_dataid[g])
+        meshes[mid] = f"mesh{mid}.obj"
+        shape = f'<mesh filename="{meshes[mid]}"/>'
     else:
         return None
     pos = m.geom_pos[g] - shift
@@ -123,6 +131,7 @@ def to_urdf(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> UrdfRobot:
         raise RobotError("URDF export needs a free-floating root body (a freejoint)")
     out = [f"<robot name={quoteattr(robot.name)}>"]
     friction = np.zeros(m.nbody)
+    meshes: dict[int, str] = {}  # mesh id -> file name, for the collision meshes used
     for b in range(1, m.nbody):
         mass = max(float(m.body_mass[b]), 1e-6)
         ipos = m.body_ipos[b] - shift[b]
@@ -137,7 +146,7 @@ def to_urdf(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> UrdfRobot:
         for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
             if m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0:
                 continue  # visual only
-            xml = _geom(m, g, shift[b])
+            xml = _geom(m, g, shift[b], meshes)
             if xml is not None:
                 body.append(xml)
                 friction[b] = max(friction[b], float(m.geom_friction[g, 0]))
@@ -168,7 +177,17 @@ def to_urdf(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> UrdfRobot:
             out.append(f'<joint name={fixed} type="fixed">{origin}{link}</joint>')
     out.append("</robot>")
     moved = tuple(names[m.joint(mj).bodyid[0]] for mj in robot.mj_joints)
-    return UrdfRobot("\n".join(out), ("", *names[1:]), names[base], moved, friction)
+    objs = {name: _obj(m, mid) for mid, name in meshes.items()}
+    return UrdfRobot("\n".join(out), ("", *names[1:]), names[base], moved, friction, objs)
+
+
+def _obj(m: mujoco.MjModel, mid: int) -> str:
+    """Mesh ``mid`` of the compiled model (MuJoCo's convex hull data frame) as OBJ text."""
+    v0, nv = m.mesh_vertadr[mid], m.mesh_vertnum[mid]
+    f0, nf = m.mesh_faceadr[mid], m.mesh_facenum[mid]
+    lines = [f"v {_v(x)}" for x in m.mesh_vert[v0 : v0 + nv]]
+    lines += ["f " + " ".join(str(int(i) + 1) for i in f) for f in m.mesh_face[f0 : f0 + nf]]
+    return "\n".join(lines) + "\n"
 
 
 #: One URDF file per robot, torso shift and process: ``(name, mjcf, shift) -> (path, UrdfRobot)``.
@@ -183,6 +202,8 @@ def urdf_file(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> tuple[Path, UrdfRobot]
     if key not in _FILES:
         u = to_urdf(robot, shift)
         path = Path(tempfile.mkdtemp(prefix="imitwalk-")) / f"{robot.name}.urdf"
+        for name, text in u.meshes.items():
+            (path.parent / name).write_text(text)
         path.write_text(u.text)
         _FILES[key] = (path, u)
     return _FILES[key]
