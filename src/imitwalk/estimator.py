@@ -15,7 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["STATE_NAMES", "Estimate", "StateEstimator"]
+__all__ = ["GRAVITY", "STATE_NAMES", "Estimate", "StateEstimator"]
+
+#: Standard gravity [m/s²].
+GRAVITY = 9.81
 
 #: The full state vector, in order.
 STATE_NAMES = ("gyro_x", "gyro_y", "gyro_z", "roll", "pitch", "heading", "load_left", "cop_x")
@@ -65,13 +68,21 @@ class StateEstimator:
 
     def update(self, gyro: np.ndarray, accel: np.ndarray, foot_force: np.ndarray) -> Estimate:
         """Fold in one tick of readings: gyro ``(3,)`` [rad/s], accel ``(3,)`` [m/s²],
-        foot_force ``(2, k)`` [N]."""
+        foot_force ``(2, k)`` [N].
+
+        The tilt starts from the first reading that feels gravity (|accel| above half of
+        it): a robot set down a fraction of a millimetre above the floor is in free fall
+        for its first tick, and that reading's direction says nothing (it read −180° of
+        roll, which the filter took a second to forget). Until then the tilt is level.
+        """
         gyro = np.asarray(gyro, dtype=float)
         ax, ay, az = np.asarray(accel, dtype=float)
         acc_roll = float(np.arctan2(ay, az))
         acc_pitch = float(np.arctan2(-ax, np.hypot(ay, az)))
+        feels_gravity = np.hypot(np.hypot(ax, ay), az) > 0.5 * GRAVITY
         if not self._started or not np.isfinite(acc_roll):
-            self.roll, self.pitch, self._started = acc_roll, acc_pitch, True
+            if feels_gravity and np.isfinite(acc_roll):
+                self.roll, self.pitch, self._started = acc_roll, acc_pitch, True
         else:
             a = self.tau / (self.tau + self.dt)
             self.roll = a * (self.roll + gyro[0] * self.dt) + (1 - a) * acc_roll

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.evaluate import compare_falls, judged_gain, load_gait, wilson
 from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
@@ -23,7 +24,7 @@ from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["OPEN_LOOP", "JudgeJob", "judge_protocol", "run_controller"]
+__all__ = ["OPEN_LOOP", "JudgeJob", "TickRun", "judge_protocol", "load_run", "run_controller"]
 
 #: The controller every run can build: its reference played as it is.
 OPEN_LOOP = "open_loop"
@@ -56,11 +57,37 @@ class JudgeJob:
 _CACHE: dict = {}
 
 
+@dataclass(frozen=True)
+class TickRun:
+    """A finished per-tick run (:mod:`imitwalk.ticklearn`): its reference, the scale it
+    reached and the feedback laws of each controller it can build."""
+
+    ref: object
+    scale: float
+    laws: dict
+
+    def controllers(self) -> tuple[str, ...]:
+        return (*self.laws, OPEN_LOOP)
+
+
+def load_run(run_dir):
+    """A finished run folder: a :class:`TickRun`, or the step-level learner's gait."""
+    rd = RunDir(run_dir)
+    if rd.read_json("config.json").get("learner") == "tick":
+        from imitwalk.retarget.reference import Reference
+        from imitwalk.ticklearn import load_laws
+
+        metrics = rd.read_json("metrics.json")
+        ref = Reference.load(rd.file("reference.npz"))
+        return TickRun(ref, float(metrics["scale_reached"]), load_laws(run_dir))
+    return load_gait(run_dir)
+
+
 def _loaded(run_dir: str):
     key = (run_dir, RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
-        _CACHE[key] = load_gait(run_dir)
+        _CACHE[key] = load_run(run_dir)
     return _CACHE[key]
 
 
@@ -70,12 +97,20 @@ def run_controller(job: JudgeJob) -> dict:
 
     lg = _loaded(job.run_dir)
     scale = lg.scale if job.scale is None else job.scale
-    ref = lg.ref if job.controller == OPEN_LOOP else lg.gait.ref
+    tick = isinstance(lg, TickRun)
+    ref = lg.ref if job.controller == OPEN_LOOP or tick else lg.gait.ref
     steps = round(job.seconds / ref.dt)
     q_ref = ref.trajectory(scale, job.seconds)
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
     if job.controller == OPEN_LOOP:
         ro = playback(plant, q_ref, q0=q_ref[0])
+    elif tick:
+        from imitwalk.feedback import TickPolicy
+
+        if job.controller not in lg.laws:
+            raise unknown_name("controller", job.controller, lg.controllers(), ConfigError)
+        laws = lg.laws[job.controller]
+        ro = run(plant, TickPolicy(ref, scale, laws, job.robot.joint_names, job.seconds), steps)
     else:
         ro = run(plant, lg.policy(job.robot, scale, job.gain), steps)
     m = walk_metrics(

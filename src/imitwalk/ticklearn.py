@@ -1,0 +1,372 @@
+"""Learning to balance every tick: trial-picked feedback, then the paper's loop on top.
+
+Three stages, each checkpointed, so that an interrupted run resumes where it stopped
+and ends where an uninterrupted one would:
+
+1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
+   roll, heading → hip yaw, with each gain chosen in turn from its candidates by
+   trials at the top scale: fewest falls, then the longest walks before them, then the
+   least measured eq.-6 cost Γ (the balance gains, on ``trial_protocol`` robots, where
+   they fall) or the least |yaw drift| (the heading gain, on ``train_protocol`` robots,
+   where they walk the whole trial). This is the baseline; the learned law starts from it.
+2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
+   robots (with exploration in a scale's first iteration), record, fit the per-tick
+   model of eqs. 3–4 (:class:`~imitwalk.tickmodel.PhaseModel`), turn it into gains by
+   the receding-horizon eq.-6 search (:func:`~imitwalk.lqr.horizon_gains`) and go on;
+   a scale is passed by an iteration without exploration in which no training robot
+   falls. The learned law acts on top of the trial-picked one.
+3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the top
+   scale on the trial robots; the fraction that falls least, then costs least, is kept
+   (0: the trial-picked law alone).
+
+Training robots come from ``train_protocol`` with seeds no evaluation uses.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field, replace
+
+import numpy as np
+
+from imitwalk.config import from_dict, to_dict
+from imitwalk.errors import RunError
+from imitwalk.feedback import Episode, FeedbackLaw
+from imitwalk.lqr import Costs, horizon_gains
+from imitwalk.parallel import run_parallel
+from imitwalk.perturb import TRAIN_SEED_BASE, TRIAL_SEED_BASE
+from imitwalk.protocol import load_protocol
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+from imitwalk.tickconfig import TickLearnConfig
+from imitwalk.tickmodel import PhaseModel, nominal_profile
+from imitwalk.tickrun import TickJob, TickResult, run_tick_episode
+
+__all__ = ["TRIAL_GAINS", "TickProgress", "learn_tick", "load_laws"]
+
+#: The trial-picked gains, in the order they are tried: (setting, channel, feature, the
+#: measure that decides between candidates that fall alike: the eq.-6 cost Γ for the
+#: balance gains, the mean |yaw drift| for the heading's).
+TRIAL_GAINS = (
+    ("pitch", "ankle_pitch", "gyro_y", "cost"),
+    ("roll", "ankle_roll", "gyro_x", "cost"),
+    ("heading", "hip_yaw", "heading", "abs_yaw_deg"),
+)
+
+
+@dataclass
+class TickProgress:
+    """Where a run is (``checkpoint.json``); nothing else crosses the stages.
+
+    Attributes:
+        stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
+        gains: the trial-picked gains so far, by setting name; trial: the next gain.
+        scale_index, iteration: where the schedule is; passed: scales passed.
+        trust: the fraction of the learned law kept (``None`` until decided).
+        sim_seconds, wall_seconds: what learning has cost so far [s].
+    """
+
+    stage: str = "trials"
+    gains: dict = field(default_factory=dict)
+    trial: int = 0
+    scale_index: int = 0
+    iteration: int = 0
+    passed: list = field(default_factory=list)
+    trust: float | None = None
+    sim_seconds: float = 0.0
+    wall_seconds: float = 0.0
+
+
+def _feedback_law(cfg: TickLearnConfig, gains: dict) -> FeedbackLaw:
+    channels = tuple(c for _, c, _, _ in TRIAL_GAINS)
+    features = tuple(dict.fromkeys(f for _, _, f, _ in TRIAL_GAINS))
+    law = FeedbackLaw.zero(channels, features, cfg.trials.box)
+    for name, channel, feature, _ in TRIAL_GAINS:
+        law = law.with_gain(channel, feature, float(gains.get(name, 0.0)))
+    return law
+
+
+class _Learner:
+    """The stages' shared context: the run folder, the robots and the budget."""
+
+    def __init__(self, ref: Reference, robot: Robot, cfg: TickLearnConfig, rd: RunDir, progress):
+        self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
+        self.say = progress or (lambda _line: None)
+        self.protocol = load_protocol(cfg.train_protocol)
+        self.trial_protocol = load_protocol(cfg.trial_protocol)
+        self.scales = cfg.scales()
+        self.ref_path = str(rd.file("reference.npz"))
+
+    def robots(self, n: int, first: int, seconds: float, trial: bool = False):
+        protocol = self.trial_protocol if trial else self.protocol
+        return [
+            protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds) for j in range(n)
+        ]
+
+    def run(self, state: TickProgress, scale, laws, draws, seconds, explore=0.0, rng=0):
+        t0 = time.perf_counter()
+        jobs = [
+            TickJob(
+                self.ref_path,
+                self.robot,
+                scale,
+                tuple(laws),
+                d.seed,
+                d.options,
+                seconds,
+                explore,
+                (self.cfg.seed, rng, j),
+                self.cfg.engine,
+            )
+            for j, d in enumerate(draws)
+        ]
+        out = run_parallel(run_tick_episode, jobs, self.cfg.workers)
+        state.sim_seconds += sum(r.seconds for r in out)
+        state.wall_seconds += time.perf_counter() - t0
+        return out
+
+
+def _rank(results: list[TickResult], measure: str = "cost") -> tuple[int, float, float]:
+    """Fewest falls, then the longest walks before them, then the least ``measure``
+    (``cost``: Γ; ``abs_yaw_deg``: |yaw drift|) over the robots that did not fall."""
+    falls = sum(r.fell for r in results)
+    before = -sum(r.fall_time_s or 0.0 for r in results if r.fell)
+    up = [r for r in results if not r.fell]
+    if not up:
+        return falls, before, float("inf")
+    values = [r.cost if measure == "cost" else abs(r.yaw_drift_deg) for r in up]
+    return falls, before, float(np.mean(values))
+
+
+def _summary(results: list[TickResult]) -> dict:
+    return {
+        "falls": int(sum(r.fell for r in results)),
+        "robots": len(results),
+        "cost": _rank(results)[2],
+        "walked_s": float(sum(r.seconds for r in results)),
+        "distance_m": float(np.mean([r.distance_m for r in results])),
+        "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
+    }
+
+
+def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
+    """Stage 1: one gain at a time, each from its candidates, at the top scale."""
+    cfg, top = lr.cfg, lr.scales[-1]
+    n, first, seconds = cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds
+    hard, walking = lr.robots(n, first, seconds, trial=True), lr.robots(n, first, seconds)
+    while state.trial < len(TRIAL_GAINS):
+        name, channel, feature, measure = TRIAL_GAINS[state.trial]
+        # the heading is judged where the robots walk the whole trial; balance, where they fall
+        draws = walking if measure == "abs_yaw_deg" else hard
+        table = []
+        for value in getattr(cfg.trials, name):
+            gains = {**state.gains, name: float(value)}
+            res = lr.run(state, top, [_feedback_law(cfg, gains)], draws, cfg.trials.seconds)
+            table.append((_rank(res, measure), float(value), _summary(res)))
+        best = min(table, key=lambda row: (row[0], abs(row[1])))
+        state.gains[name] = best[1]
+        log.append(
+            {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
+             "kept": best[1], "table": [{"value": v, **s} for _, v, s in table]}
+        )  # fmt: skip
+        lr.say(
+            f"trials: {feature} -> {channel} = {best[1]:g} "
+            + " ".join(f"[{v:g}: {s['falls']}/{s['robots']} fell, {s['walked_s']:.0f} s, "
+                       f"{s['cost']:.3f}, {s['abs_yaw_deg']:.1f} deg]" for _, v, s in table)
+        )  # fmt: skip
+        state.trial += 1
+        _checkpoint(lr, state, log)
+    state.stage = "schedule" if cfg.lqr.enabled else "done"
+
+
+def _learned_law(lr: _Learner, episodes: list[Episode]):
+    """Fit the model on ``episodes`` and turn it into the learned law (and the model);
+    the states are the features less their mean at each phase in ``episodes``."""
+    c = lr.cfg.lqr
+    n = lr.ref.loops.shape[1]
+    shell = FeedbackLaw.zero(c.channels, c.features, c.box, n_ticks=n, memory=True)
+    shell = replace(shell, nominal=nominal_profile(episodes, c.features, n))
+    model = PhaseModel(n_phases=n, width=c.width, ridge=c.ridge).fit(episodes, shell)
+    costs = Costs(tuple(c.state_cost), c.action_cost, c.change_cost, c.horizon)
+    return replace(shell, gains=horizon_gains(model, costs)), model
+
+
+def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
+    """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
+    cfg = lr.cfg
+    base = _feedback_law(cfg, state.gains)
+    learned, model = _load_learned(lr.rd), None
+    while state.scale_index < len(lr.scales):
+        scale = lr.scales[state.scale_index]
+        explore = cfg.lqr.explore if state.iteration == 0 else 0.0
+        n = len(log)
+        draws = lr.robots(cfg.robots, TRAIN_SEED_BASE + 1 + cfg.robots * n, cfg.seconds)
+        laws = [base] if learned is None else [base, learned]
+        if learned is None:  # the first iteration records the trial-picked law's channels
+            laws = [base, FeedbackLaw.zero(cfg.lqr.channels, cfg.lqr.features, cfg.lqr.box)]
+        res = lr.run(state, scale, laws, draws, cfg.seconds, explore, rng=n)
+        new = [(scale, r.episode) for r in res if r.episode is not None]
+        held = None
+        if model is not None:  # the last model, on episodes it has not seen
+            pred = model.score_episodes([e for _, e in new], learned)
+            held = pred.to_dict() if pred else None
+        data.extend(new)
+        near = [e for s, e in data if abs(s - scale) < 1e-9]
+        learned, model = _learned_law(lr, near)
+        fell = sum(r.fell for r in res)
+        entry = {"stage": "schedule", "scale": scale, "iteration": state.iteration,
+                 "explore": explore, **_summary(res), "held_out": held}  # fmt: skip
+        log.append(entry)
+        ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
+        lr.say(
+            f"scale {scale:.2f} it {state.iteration} | fell {fell}/{len(res)} | "
+            f"cost {entry['cost']:.3f} | model err / persistence {ratio}"
+        )
+        if explore == 0.0 and fell == 0:
+            state.passed.append(scale)
+            state.scale_index, state.iteration = state.scale_index + 1, 0
+        elif state.iteration + 1 >= cfg.iterations:
+            break
+        else:
+            state.iteration += 1
+        _save_learned(lr.rd, learned)
+        _checkpoint(lr, state, log, data)
+    _save_learned(lr.rd, learned)
+    state.stage = "trust"
+    return learned
+
+
+def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
+    """Stage 3: how much of the learned law to keep, by trials at the scale reached."""
+    cfg = lr.cfg
+    if learned is None or not state.passed:
+        state.trust, state.stage = 0.0, "done"
+        return
+    scale = max(state.passed)
+    draws = lr.robots(cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds, trial=True)
+    base = _feedback_law(cfg, state.gains)
+    table = []
+    for frac in cfg.lqr.trust:
+        laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
+        res = lr.run(state, scale, laws, draws, cfg.trials.seconds)
+        table.append((_rank(res), float(frac), _summary(res)))
+    best = min(table, key=lambda row: (row[0], row[1]))
+    state.trust, state.stage = best[1], "done"
+    log.append({"stage": "trust", "scale": scale, "kept": best[1],
+                "table": [{"fraction": f, **s} for _, f, s in table]})  # fmt: skip
+    lr.say(
+        f"trust at {scale:g}: kept {best[1]:g} "
+        + " ".join(
+            f"[{f:g}: {s['falls']}/{s['robots']} fell, {s['cost']:.3f}]" for _, f, s in table
+        )
+    )
+
+
+def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None = None) -> None:
+    if data is not None:
+        lr.rd.write_arrays("data.npz", _stack(data))
+    lr.rd.write_log(log)
+    lr.rd.write_json("checkpoint.json", asdict(state))
+
+
+def _stack(data: list[tuple[float, Episode]]) -> dict[str, np.ndarray]:
+    if not data:
+        return {}
+    return {
+        "scale": np.array([s for s, _ in data]),
+        "length": np.array([len(e.phase) for _, e in data]),
+        "phase": np.concatenate([e.phase for _, e in data]),
+        "features": np.vstack([e.features for _, e in data]),
+        "actions": np.vstack([e.actions for _, e in data]),
+    }
+
+
+def _unstack(arrays: dict) -> list[tuple[float, Episode]]:
+    if "length" not in arrays:
+        return []
+    cut = np.cumsum(arrays["length"])[:-1]
+    parts = [np.split(arrays[k], cut) for k in ("phase", "features", "actions")]
+    return [(float(s), Episode(*p)) for s, *p in zip(arrays["scale"], *parts, strict=True)]
+
+
+def _save_learned(rd: RunDir, law: FeedbackLaw | None) -> None:
+    if law is not None:
+        rd.write_arrays("learned.npz", law.to_arrays(""))
+
+
+def _load_learned(rd: RunDir) -> FeedbackLaw | None:
+    if not rd.exists("learned.npz"):
+        return None
+    return FeedbackLaw.from_arrays(rd.read_arrays("learned.npz"), "")
+
+
+def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
+    """The controllers a finished per-tick run can build, by name: ``feedback`` (the
+    trial-picked law), ``learned`` (with the kept fraction of the model-based law on top)
+    and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""
+    rd = RunDir(run_dir)
+    metrics = rd.read_json("metrics.json")
+    cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
+    base = _feedback_law(cfg, metrics["feedback_gains"])
+    fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
+        "ankle_pitch", "gyro_y", 0.05
+    )
+    learned = (base,)
+    frac = float(metrics.get("trust") or 0.0)
+    law = _load_learned(rd)
+    if frac > 0 and law is not None:
+        learned = (base, replace(law, gains=law.gains * frac))
+    return {"learned": learned, "feedback": (base,), "fixed": (fixed,)}
+
+
+def learn_tick(
+    ref: Reference, robot: Robot, config: TickLearnConfig, run_dir, resume=False, progress=None
+) -> dict:
+    """Learn to walk ``ref`` on ``robot`` with per-tick feedback; write ``run_dir``.
+
+    Returns:
+        the summary, also written as ``metrics.json``.
+    """
+    rd = RunDir(run_dir)
+    cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
+                "learner": "tick"}  # fmt: skip
+    if resume:
+        if not rd.exists("checkpoint.json"):
+            raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
+        if rd.read_json("config.json")["learn"] != cfg_json["learn"]:
+            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        state = TickProgress(**rd.read_json("checkpoint.json"))
+        log = rd.read_log()
+        data = _unstack(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
+    else:
+        if rd.exists("checkpoint.json"):
+            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        rd.path.mkdir(parents=True, exist_ok=True)
+        rd.write_json("config.json", cfg_json)
+        ref.save(rd.file("reference.npz"))
+        state, log, data = TickProgress(), [], []
+    lr = _Learner(ref, robot, config, rd, progress)
+    if state.stage == "trials":
+        _trials(lr, state, log)
+        _checkpoint(lr, state, log, data)
+    learned = _load_learned(rd)
+    if state.stage == "schedule":
+        learned = _schedule(lr, state, log, data)
+        _checkpoint(lr, state, log, data)
+    if state.stage == "trust":
+        _trust(lr, state, log, learned)
+        _checkpoint(lr, state, log, data)
+    summary = {
+        "learner": "tick",
+        "scale_reached": max(state.passed) if state.passed else lr.scales[-1],
+        "scales_passed": state.passed,
+        "feedback_gains": state.gains,
+        "trust": state.trust,
+        "iterations": sum(1 for e in log if e["stage"] == "schedule"),
+        "sim_seconds_used_for_learning": state.sim_seconds,
+        "wall_seconds_for_learning": state.wall_seconds,
+        "config": to_dict(config),
+    }
+    rd.write_json("metrics.json", summary)
+    return summary

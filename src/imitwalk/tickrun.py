@@ -1,0 +1,110 @@
+"""One episode of the per-tick controller on one training robot, and its record.
+
+The learner (:mod:`imitwalk.ticklearn`) runs many of these in parallel
+(:func:`imitwalk.parallel.run_parallel`); only the simulator steps the physics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.feedback import Episode, FeedbackLaw, TickPolicy
+from imitwalk.robots import Robot
+from imitwalk.simtypes import SimOptions
+
+__all__ = ["TickJob", "TickResult", "run_tick_episode"]
+
+
+@dataclass(frozen=True)
+class TickJob:
+    """One episode.
+
+    Attributes:
+        ref_path: the reference (``.npz``); robot: the robot; scale: stride scale;
+        laws: the feedback laws (their outputs add up); seed: the training robot;
+        options: its simulation; seconds: simulated time [s]; explore: exploration
+        amplitude [rad] on the last law; rng: the exploration's seed; engine: the
+        physics engine; record: return the recorded episode.
+    """
+
+    ref_path: str
+    robot: Robot
+    scale: float
+    laws: tuple[FeedbackLaw, ...]
+    seed: int
+    options: SimOptions
+    seconds: float
+    explore: float = 0.0
+    rng: tuple[int, ...] = (0,)
+    engine: str = "mujoco"
+    record: bool = True
+
+
+@dataclass(frozen=True)
+class TickResult:
+    """What one episode gave.
+
+    Attributes:
+        seed: the training robot; fell: whether it fell; fall_time_s: when [s];
+        seconds: simulated time [s]; distance_m: forward travel [m]; yaw_drift_deg;
+        cost: the measured eq.-6 cost Γ, the mean of |gyro|² over the walk [rad²/s²];
+        episode: the recorded ticks (``None`` unless asked for).
+    """
+
+    seed: int
+    fell: bool
+    fall_time_s: float | None
+    seconds: float
+    distance_m: float
+    yaw_drift_deg: float
+    cost: float
+    episode: Episode | None = None
+
+    def score(self) -> tuple[float, float]:
+        """How a trial ranks it: a fall first (and sooner is worse), then the cost."""
+        return (float(self.fell), self.cost)
+
+
+_REFS: dict = {}
+
+
+def _reference(path: str):
+    from imitwalk.retarget.reference import Reference
+
+    if path not in _REFS:
+        _REFS.clear()
+        _REFS[path] = Reference.load(path)
+    return _REFS[path]
+
+
+def run_tick_episode(job: TickJob) -> TickResult:
+    """Walk ``job``'s laws on its robot (runs in a worker process)."""
+    from imitwalk.metrics import walk_metrics
+    from imitwalk.sim import make_plant, run
+
+    ref = _reference(job.ref_path)
+    policy = TickPolicy(
+        ref, job.scale, job.laws, job.robot.joint_names, job.seconds, job.explore, seed=job.rng
+    )
+    plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
+    ro = run(plant, policy, len(policy.q_ref))
+    m = walk_metrics(
+        ro,
+        ref.expected_distance(job.scale, ro.seconds),
+        policy.q_ref,
+        ref.track(job.scale, ro.seconds),
+    )
+    walk = ro.gyro[ref.starts.shape[1] - ref.loops.shape[1] :]  # from the last start-up cycle
+    cost = float(np.mean(np.sum(walk**2, axis=1))) if len(walk) else float("inf")
+    return TickResult(
+        seed=job.seed,
+        fell=m.fell,
+        fall_time_s=m.fall_time_s,
+        seconds=m.seconds,
+        distance_m=m.forward_distance_m,
+        yaw_drift_deg=m.yaw_drift_deg,
+        cost=cost if not m.fell else float("inf"),
+        episode=policy.episode() if job.record else None,
+    )
