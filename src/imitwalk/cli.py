@@ -13,7 +13,6 @@ import warnings
 from collections.abc import Sequence
 
 from imitwalk import commands, robot_commands
-from imitwalk.config import RECIPES
 from imitwalk.errors import ImitwalkError
 from imitwalk.protocol import PROTOCOLS
 from imitwalk.simtypes import ENGINES
@@ -144,52 +143,51 @@ def build_parser() -> argparse.ArgumentParser:
         "--variant",
         default="extended",
         choices=("extended", "faithful"),
-        help="extended (default) or the paper as written (faithful)",
+        help="extended: per-tick balance learned by trials and the paper's loop (default); "
+        "faithful: the paper as written",
     )
     ln.add_argument("--seed", type=int, default=0, help="random seed (0)")
-    ln.add_argument(
-        "--recipe",
-        metavar="NAME|FILE",
-        help="a named set of settings, applied before --set: "
-        + ", ".join(RECIPES)
-        + " (docs/RESULTS.md), or a file of key=value lines",
-    )
     ln.add_argument("--resume", action="store_true", help="continue an interrupted run")
     ln.add_argument(
         "--set",
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="override a learning setting (e.g. schedule.stop=0.8), or a "
+        help="override a learning setting (e.g. stop=0.8, lqr.enabled=false), or a "
         "retargeting one with a retarget. prefix (repeatable)",
     )
     _command_args(ln)
     ln.add_argument("--json", action="store_true", help="print JSON")
     ln.set_defaults(func=commands.learn)
 
-    ev = sub.add_parser("evaluate", help="learned gait vs open-loop playback on perturbed robots")
+    ev = sub.add_parser(
+        "evaluate", help="every controller of a run, side by side, on a protocol's robots"
+    )
     ev.add_argument("run_dir", help="a run folder written by learn")
-    ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
-    ev.add_argument("--seeds", type=int, default=None, help="robots (10; 40 with --protocol)")
     ev.add_argument(
         "--protocol",
         metavar="NAME|FILE",
-        help="judge on a robustness protocol: " + ", ".join(PROTOCOLS) + ", or a protocol .json",
+        default="eval",
+        help="the robots: " + ", ".join(PROTOCOLS) + " (default eval), or a protocol .json",
     )
+    ev.add_argument("--seconds", type=float, default=30.0, help="simulated seconds per robot (30)")
+    ev.add_argument("--seeds", type=int, default=10, help="robots (10)")
     ev.add_argument(
         "--scale", type=float, default=None, help="judge at this scale (default: the one reached)"
     )
     ev.add_argument(
-        "--gain",
-        type=float,
-        default=None,
-        help="the learned controller's channel gain, 0-2 (default: the one its trials kept)",
+        "--controllers",
+        metavar="A,B",
+        help="which of the run's controllers (default: all of them, open_loop included)",
     )
-    ev.add_argument("--perturb", action="store_true", help="run the robustness grid instead")
+    ev.add_argument(
+        "--push-recovery",
+        action="store_true",
+        help="instead: the largest kick survived, by direction and gait phase (nominal robot)",
+    )
     ev.add_argument("--robot", default=None, help="robot (default: the run's)")
     ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     ev.add_argument("--workers", type=int, default=None, help="parallel processes")
-    _engine_arg(ev, None, "the one the run learned on")
     ev.add_argument("--json", action="store_true", help="print JSON")
     ev.set_defaults(func=commands.evaluate)
     rp = sub.add_parser("report", help="write RUN_DIR/report.html (figures, film strips, video)")

@@ -175,19 +175,26 @@ def _with_command(cfg, args: argparse.Namespace):
 
 
 def learn(args: argparse.Namespace) -> int:
-    from imitwalk.config import apply_overrides, recipe_settings
+    from imitwalk.config import apply_overrides
     from imitwalk.errors import ConfigError
-    from imitwalk.learnconfig import preset
-    from imitwalk.learner import learn as run
     from imitwalk.retarget import Reference, RetargetConfig
     from imitwalk.retarget import retarget as do_retarget
     from imitwalk.runs import RunDir
 
     robot = robot_from(args)
-    recipe = recipe_settings(args.recipe) if args.recipe else []
-    rt_set, learn_set = _split_settings(recipe + args.set)
-    cfg = apply_overrides(preset(args.variant, seed=args.seed), learn_set)
+    rt_set, learn_set = _split_settings(args.set)
+    if args.variant == "faithful":
+        from imitwalk.learnconfig import preset
+        from imitwalk.learner import learn as run
+
+        cfg = apply_overrides(preset("faithful", seed=args.seed), learn_set)
+    else:
+        from imitwalk.tickconfig import TickLearnConfig
+        from imitwalk.ticklearn import learn_tick as run
+
+        cfg = apply_overrides(TickLearnConfig(seed=args.seed), learn_set)
     rd = RunDir(args.out)
+    rd.check_writable()
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
@@ -217,23 +224,10 @@ def learn(args: argparse.Namespace) -> int:
         ref = res.reference
         ref.settings["robot"] = _where(args.robot)
         ref.settings["joint_map"] = _where(args.joint_map)
-    progress(f"learn: {cfg.variant} variant, scales {cfg.schedule.scales()}")
+    progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
-    keys = (
-        "variant",
-        "scale_reached",
-        "scales_passed",
-        "iterations",
-        "sim_seconds_used_for_learning",
-        "wall_seconds_for_learning",
-        "channel_gain",
-        "gain_trials",
-        "cadence",
-        "cadence_trials",
-        "channel_offset",
-        "offset_trials",
-    )
-    out = {k: summary[k] for k in keys}
+    out = {k: v for k, v in summary.items() if k not in ("config", "gait")}
+    out["variant"] = args.variant
     out["run_dir"] = str(rd.path)
     emit(out, args.json)
     return 0
@@ -241,33 +235,40 @@ def learn(args: argparse.Namespace) -> int:
 
 def evaluate(args: argparse.Namespace) -> int:
     from imitwalk.errors import ConfigError
-    from imitwalk.evaluate import check_gain, evaluate_run
-    from imitwalk.robustness import robustness_grid
+    from imitwalk.judge import judge_protocol
+    from imitwalk.protocol import load_protocol
     from imitwalk.runs import RunDir
 
-    check_gain(args.gain)
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     if args.robot is None:
         args.robot, args.joint_map = _run_robot(rd, cfg)
-    learned_on = cfg.get("learn", {}).get("engine", "mujoco")
-    if args.protocol is not None:
-        if args.engine is not None:
-            raise ConfigError("--engine: a protocol names its own engine (e.g. --protocol bullet)")
-        return _evaluate_protocol(args, rd, robot_from(args))
-    args.engine = args.engine or learned_on
     robot = robot_from(args)
-    args.seeds = 10 if args.seeds is None else args.seeds
-    common = {"workers": args.workers, "scale": args.scale, "engine": args.engine}
-    common["gain"] = args.gain
-    if args.perturb:
-        progress(f"evaluate: robustness grid, {args.seeds} seeds per cell, {args.seconds:g} s")
-        out = robustness_grid(rd.path, robot, args.seconds, args.seeds, progress=progress, **common)
-    else:
-        progress(f"evaluate: {args.seeds} robots x {args.seconds:g} s, learned and open loop")
-        out = evaluate_run(rd.path, robot, args.seconds, args.seeds, **common)
-    kind = "robustness" if args.perturb else "evaluation"
-    rd.write_json(_result_name(kind, args, learned_on), out)
+    if args.push_recovery:
+        return _push_recovery(args, rd, robot)
+    protocol = load_protocol(args.protocol)
+    if args.seeds < 1 or not args.seconds > 0:
+        raise ConfigError(
+            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
+        )
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    progress(
+        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
+        f"{args.seeds} robots x {args.seconds:g} s"
+    )
+    out = judge_protocol(
+        rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
+        scale=args.scale, workers=args.workers,
+    )  # fmt: skip
+    for name, side in out["controllers"].items():
+        lo, hi = side["survival_ci95"]
+        progress(
+            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
+            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+        )
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
     emit(out, args.json)
     return 0
 
@@ -284,45 +285,20 @@ def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
     return name or "hoap2", settings.get("joint_map")
 
 
-def _evaluate_protocol(args: argparse.Namespace, rd, robot) -> int:
-    from imitwalk.errors import ConfigError
-    from imitwalk.judge import judge_protocol
-    from imitwalk.protocol import load_protocol
+def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
+    from imitwalk.pushes import push_recovery
 
-    protocol = load_protocol(args.protocol)
-    if args.perturb:
-        raise ConfigError("--protocol and --perturb are two evaluations; give one")
-    seeds = 40 if args.seeds is None else args.seeds
-    if seeds < 1 or not args.seconds > 0:
-        raise ConfigError(f"--seeds {seeds} --seconds {args.seconds:g}: expected >= 1 and > 0")
-    progress(
-        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
-        f"{seeds} robots x {args.seconds:g} s"
-    )
-    out = judge_protocol(
-        rd.path, robot, protocol, seeds, args.seconds, scale=args.scale,
-        workers=args.workers, gain=args.gain,
-    )  # fmt: skip
+    progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    out = push_recovery(rd.path, robot, controllers=chosen, scale=args.scale, workers=args.workers)
     for name, side in out["controllers"].items():
-        lo, hi = side["survival_ci95"]
+        least = side["min_by_direction"].items()
         progress(
-            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
-            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
-            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+            f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
         )
-    scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
+    rd.write_json("push_recovery.json", out)
     emit(out, args.json)
     return 0
-
-
-def _result_name(kind: str, args: argparse.Namespace, learned_on: str) -> str:
-    """``evaluation.json``, ``evaluation_scale0.9.json``, ``evaluation_gain0.25.json``,
-    ``evaluation_bullet.json`` (on another engine than the run learned on) ..."""
-    scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    gain = "" if args.gain is None else f"_gain{args.gain:g}"
-    engine = "" if args.engine == learned_on else f"_{args.engine}"
-    return f"{kind}{scale}{gain}{engine}.json"
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -3,31 +3,18 @@
 ``apply_overrides(cfg, ["search.generations=2", "params.sway=0.8"])`` returns a copy
 of ``cfg`` with those fields replaced, converting each value to the type of the
 field it replaces. An unknown key raises :class:`~imitwalk.errors.ConfigError`
-listing the valid ones. A *recipe* is a named set of such overrides shipped with the
-package (``imitwalk/recipes/NAME.txt``, one ``key=value`` a line, ``#`` comments), or a
-file of the same form: :func:`recipe_settings`.
+listing the valid ones.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
-from importlib import resources
-from pathlib import Path
 from typing import Any
 
 from imitwalk.errors import ConfigError, unknown_name
 
-__all__ = ["RECIPES", "apply_overrides", "from_dict", "recipe_settings", "to_dict"]
-
-#: The recipes shipped with the package, by name.
-RECIPES = tuple(
-    sorted(
-        f.name[:-4]
-        for f in resources.files("imitwalk.recipes").iterdir()
-        if f.name.endswith(".txt")
-    )
-)
+__all__ = ["apply_overrides", "from_dict", "to_dict"]
 
 
 def _coerce(text: str, current: Any, key: str) -> Any:
@@ -117,31 +104,3 @@ def _has_defaults(cls: type) -> bool:
     except TypeError:
         return False
     return True
-
-
-def recipe_settings(name: str) -> list[str]:
-    """The ``key=value`` overrides of a recipe: one of :data:`RECIPES`, or a file path.
-
-    Raises:
-        ConfigError: an unknown recipe (listing the valid ones), an unreadable file, or a
-            line that is not ``key=value``.
-    """
-    if name in RECIPES:
-        text = resources.files("imitwalk.recipes").joinpath(f"{name}.txt").read_text()
-    elif Path(name).is_file():
-        try:
-            text = Path(name).read_text()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ConfigError(f"recipe {name}: cannot be read ({exc})") from None
-    else:
-        valid = ", ".join(RECIPES)
-        raise ConfigError(f"unknown recipe {name!r} (no such built-in one or file); valid: {valid}")
-    out = []
-    for n, line in enumerate(text.splitlines(), 1):
-        line = line.split("#", 1)[0].strip()
-        if not line:
-            continue
-        if "=" not in line:
-            raise ConfigError(f"recipe {name}, line {n}: {line!r} is not key=value")
-        out.append(line)
-    return out

@@ -1,4 +1,4 @@
-"""Learning diagnostics of a run: learning curves, gyro traces, the robustness heat map.
+"""Learning diagnostics of a run: learning curves, gyro traces, paths, push recovery.
 
 Like :mod:`imitwalk.plots`, each function takes data and returns a Figure drawn on the
 Agg canvas; nothing here imports MuJoCo.
@@ -14,7 +14,7 @@ from matplotlib.ticker import MaxNLocator
 
 from imitwalk.plots import _figure
 
-__all__ = ["gyro_traces", "learning_curves", "robustness_heatmap"]
+__all__ = ["gyro_traces", "learning_curves", "push_polar", "tick_curves", "torso_paths"]
 
 
 def _ratio(entry: dict, level: str) -> float:
@@ -120,27 +120,63 @@ def torso_paths(
     return fig
 
 
-def robustness_heatmap(robustness: dict) -> Figure:
-    """Survival per perturbation cell (rows) for the learned controller and open loop."""
-    cells = robustness.get("cells", {})
-    names = list(cells)
-    modes = ("learned", "open_loop")
-    M = np.array(
-        [[cells[c][m]["survived"] / max(1, cells[c][m]["of"]) for m in modes] for c in names]
-    ).reshape(-1, 2)
-    fig = _figure(5.0, 1.2 + 0.32 * max(1, len(names)))
-    ax = fig.add_subplot()
-    if not names:
-        ax.set_axis_off()
-        ax.set_title("Robustness: no cells")
+def tick_curves(log: Sequence[dict]) -> Figure:
+    """A per-tick run's learning: each schedule iteration's falls, measured eq.-6 cost Γ
+    and its model's held-out one-tick error over "nothing changes"; dotted lines mark
+    where the scale changes."""
+    sched = [e for e in log if e.get("stage") == "schedule"]
+    fig = _figure(8.0, 6.0)
+    axes = fig.subplots(3, 1, sharex=True)
+    if not sched:
+        axes[0].set_title("no schedule iterations logged (the model-based law was off)")
         return fig
-    im = ax.imshow(M, cmap="RdYlGn", vmin=0.0, vmax=1.0, aspect="auto")
-    for (i, j), _v in np.ndenumerate(M):
-        c = cells[names[i]][modes[j]]
-        text = f"{c['survived']}/{c['of']}  {c.get('distance_m', np.nan):.2f} m"
-        ax.text(j, i, text, ha="center", va="center", fontsize=8)
-    ax.set_xticks([0, 1], ["learned", "open loop"])
-    ax.set_yticks(range(len(names)), names)
-    fig.colorbar(im, ax=ax, label="fraction survived")
-    ax.set_title("Robustness: survived / robots, mean distance")
+    it = np.arange(len(sched))
+    axes[0].bar(it, [e["falls"] for e in sched], color="tab:red", label="falls")
+    axes[0].plot(it, [e["robots"] for e in sched], "k_", ms=14, label="robots")
+    axes[0].set_ylabel("falls")
+    axes[1].plot(it, [e["cost"] for e in sched], "o-", label="measured Γ")
+    axes[1].set_ylabel("cost Γ(ω)")
+    ratio = [np.nan if not e.get("held_out") else e["held_out"]["ratio_to_persistence"]
+             for e in sched]  # fmt: skip
+    axes[2].plot(it, ratio, "o-", label="model / persistence")
+    axes[2].axhline(1.0, color="k", ls="--", lw=0.8, label='"nothing changes"')
+    axes[2].set_ylabel("held-out MSE ratio")
+    axes[2].set_xlabel("schedule iteration")
+    axes[2].xaxis.set_major_locator(MaxNLocator(integer=True))
+    for ax in axes:
+        ax.legend(fontsize=8)
+    scales = [e["scale"] for e in sched]
+    for i, s in enumerate(scales):
+        if i == 0 or s != scales[i - 1]:
+            for a in axes:
+                a.axvline(i - 0.5, color="0.6", ls=":", lw=1.0)
+            where = axes[0].get_xaxis_transform()
+            axes[0].text(i - 0.4, 1.01, f"{s:g}", transform=where, fontsize=8)
+    return fig
+
+
+def push_polar(result: dict) -> Figure:
+    """Push recovery (:func:`imitwalk.pushes.push_recovery`) as a polar plot: for each
+    controller, the largest kick survived [m/s] at each direction (the phases of the
+    gait cycle spread around it, ±20°)."""
+    fig = _figure(6.0, 6.0)
+    ax = fig.add_subplot(projection="polar")
+    angles = {"forward": 0.0, "left": np.pi / 2, "back": np.pi, "right": -np.pi / 2}
+    colors = ("tab:green", "tab:blue", "tab:orange", "tab:gray")
+    for (name, side), color in zip(result.get("controllers", {}).items(), colors, strict=False):
+        th, r = [], []
+        for d, speeds in side["table"].items():
+            spread = np.linspace(-np.pi / 9, np.pi / 9, len(speeds))
+            th.extend(angles[d] + spread)
+            r.extend(speeds)
+        order = np.argsort(np.mod(th, 2 * np.pi))
+        th, r = np.mod(np.asarray(th)[order], 2 * np.pi), np.asarray(r)[order]
+        ax.plot(np.r_[th, th[:1]], np.r_[r, r[:1]], "o-", color=color, ms=3, lw=1, label=name)
+    ax.set_theta_zero_location("N")
+    ax.set_xticks(list(angles.values()), list(angles))
+    top = result.get("settings", {}).get("top_mps")
+    if top:
+        ax.set_ylim(0, top)
+    ax.set_title("Largest kick survived for 5 s [m/s], by direction and gait phase", fontsize=9)
+    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.12))
     return fig

@@ -112,9 +112,10 @@ class GaitModel:
 
     def embedding(self, scale: float) -> GaitEmbedding:
         """The embedding of a schedule scale."""
-        return self.embeddings[self._key(scale)]
+        return self.embeddings[self.key(scale)]
 
-    def _key(self, scale: float) -> float:
+    def key(self, scale: float) -> float:
+        """The schedule scale ``scale`` is (to 1e-9); unknown scales list the valid ones."""
         for s in self.scales:
             if abs(s - scale) < 1e-9:
                 return s
@@ -122,7 +123,7 @@ class GaitModel:
 
     def nominal_action(self, scale: float, tick: int) -> np.ndarray:
         """χ = (φ, r, h) of the reference at loop tick ``tick`` (φ unwrapped over cycles)."""
-        nom = self.nominal[self._key(scale)]
+        nom = self.nominal[self.key(scale)]
         n = len(nom)
         cycles, i = divmod(tick, n)
         out = nom[i].copy()
@@ -147,7 +148,7 @@ class GaitModel:
         not say which tick it is; there, given the ``tick`` whose nominal φ this is, the
         residual is that tick's own.
         """
-        key = self._key(scale)
+        key = self.key(scale)
         res, (sign, table) = self.residuals[key], self._phase_tables[key]
         by_tick = self._by_tick.get(key)
         if tick is not None and by_tick is not None and by_tick[tick % len(res)]:
@@ -164,7 +165,7 @@ class GaitModel:
 
     def phase_step(self, scale: float) -> float:
         """Mean φ advance per tick of the nominal loop [rad]."""
-        nom = self.nominal[self._key(scale)]
+        nom = self.nominal[self.key(scale)]
         return float((nom[-1, 0] - nom[0, 0]) / (len(nom) - 1))
 
     def report(self) -> dict:

@@ -16,18 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
-from imitwalk.evaluate import compare_falls, judged_gain, load_gait, wilson
+from imitwalk.evaluate import compare_falls, wilson
 from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
 from imitwalk.protocol import Protocol
+from imitwalk.replay import OPEN_LOOP, LoadedRun, load_run
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["OPEN_LOOP", "JudgeJob", "TickRun", "judge_protocol", "load_run", "run_controller"]
-
-#: The controller every run can build: its reference played as it is.
-OPEN_LOOP = "open_loop"
+__all__ = ["JudgeJob", "judge_protocol", "run_controller"]
 
 
 @dataclass(frozen=True)
@@ -38,8 +36,7 @@ class JudgeJob:
         run_dir: the run folder; robot: the robot; controller: its name (``open_loop``,
         ``learned``); seed: the protocol's robot; options: that robot's simulation;
         furthest: the factor it drew furthest from nominal; seconds: simulated time
-        [s]; scale: the stride scale (``None``: the run's); engine: the physics engine;
-        gain: the learned controller's channel gain (``None``: the run's).
+        [s]; scale: the stride scale (``None``: the run's); engine: the physics engine.
     """
 
     run_dir: str
@@ -51,39 +48,12 @@ class JudgeJob:
     seconds: float
     scale: float | None
     engine: str
-    gain: float | None = None
 
 
 _CACHE: dict = {}
 
 
-@dataclass(frozen=True)
-class TickRun:
-    """A finished per-tick run (:mod:`imitwalk.ticklearn`): its reference, the scale it
-    reached and the feedback laws of each controller it can build."""
-
-    ref: object
-    scale: float
-    laws: dict
-
-    def controllers(self) -> tuple[str, ...]:
-        return (*self.laws, OPEN_LOOP)
-
-
-def load_run(run_dir):
-    """A finished run folder: a :class:`TickRun`, or the step-level learner's gait."""
-    rd = RunDir(run_dir)
-    if rd.read_json("config.json").get("learner") == "tick":
-        from imitwalk.retarget.reference import Reference
-        from imitwalk.ticklearn import load_laws
-
-        metrics = rd.read_json("metrics.json")
-        ref = Reference.load(rd.file("reference.npz"))
-        return TickRun(ref, float(metrics["scale_reached"]), load_laws(run_dir))
-    return load_gait(run_dir)
-
-
-def _loaded(run_dir: str):
+def _loaded(run_dir: str) -> LoadedRun:
     key = (run_dir, RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
@@ -93,28 +63,19 @@ def _loaded(run_dir: str):
 
 def run_controller(job: JudgeJob) -> dict:
     """Walk ``job``'s controller on its robot; its walk metrics, seed and furthest factor."""
-    from imitwalk.sim import make_plant, playback, run
+    from imitwalk.sim import make_plant, run
 
-    lg = _loaded(job.run_dir)
-    scale = lg.scale if job.scale is None else job.scale
-    tick = isinstance(lg, TickRun)
-    ref = lg.ref if job.controller == OPEN_LOOP or tick else lg.gait.ref
-    steps = round(job.seconds / ref.dt)
-    q_ref = ref.trajectory(scale, job.seconds)
+    lr = _loaded(job.run_dir)
+    scale = lr.scale if job.scale is None else job.scale
+    ref = lr.ref
+    policy = lr.policy(job.controller, job.robot, scale, job.seconds)
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
-    if job.controller == OPEN_LOOP:
-        ro = playback(plant, q_ref, q0=q_ref[0])
-    elif tick:
-        from imitwalk.feedback import TickPolicy
-
-        if job.controller not in lg.laws:
-            raise unknown_name("controller", job.controller, lg.controllers(), ConfigError)
-        laws = lg.laws[job.controller]
-        ro = run(plant, TickPolicy(ref, scale, laws, job.robot.joint_names, job.seconds), steps)
-    else:
-        ro = run(plant, lg.policy(job.robot, scale, job.gain), steps)
+    ro = run(plant, policy, round(job.seconds / ref.dt))
     m = walk_metrics(
-        ro, ref.expected_distance(scale, ro.seconds), q_ref, ref.track(scale, ro.seconds)
+        ro,
+        ref.expected_distance(scale, ro.seconds),
+        ref.trajectory(scale, job.seconds),
+        ref.track(scale, ro.seconds),
     )
     return {**m.to_dict(), "seed": job.seed, "furthest": job.furthest}
 
@@ -152,12 +113,12 @@ def judge_protocol(
     protocol: Protocol,
     seeds: int = 40,
     seconds: float = 30.0,
-    controllers: tuple[str, ...] = ("learned", OPEN_LOOP),
+    controllers: tuple[str, ...] | None = None,
     scale: float | None = None,
     workers: int | None = None,
-    gain: float | None = None,
 ) -> dict:
-    """Every controller in ``controllers`` on robots ``0 … seeds − 1`` of ``protocol``.
+    """Every controller in ``controllers`` (``None``: every one the run can build) on
+    robots ``0 … seeds − 1`` of ``protocol``.
 
     Returns:
         ``{"protocol": …, "settings": …, "controllers": {name: side}, "comparison":
@@ -166,6 +127,11 @@ def judge_protocol(
         ``progress_ratio_min``, ``falls_by_furthest_factor`` and ``per_seed``.
     """
     metrics = RunDir(run_dir).read_json("metrics.json")
+    valid = _loaded(str(run_dir)).controllers()
+    controllers = valid if controllers is None else tuple(controllers)
+    for c in controllers:
+        if c not in valid:
+            raise unknown_name("controller", c, valid, ConfigError)
     draws = [protocol.draw(s, robot, seconds=seconds) for s in range(seeds)]
     jobs = [
         JudgeJob(
@@ -178,7 +144,6 @@ def judge_protocol(
             seconds,
             scale,
             protocol.engine,
-            gain,
         )
         for c in controllers
         for d in draws
@@ -192,7 +157,7 @@ def judge_protocol(
             "seconds": seconds,
             "engine": protocol.engine,
             "scale": scale if scale is not None else metrics.get("scale_reached"),
-            "channel_gain": judged_gain(metrics, gain),
+            "controllers": list(controllers),
         },
         "controllers": {c: _side(runs, protocol.factors) for c, runs in by.items()},
         "comparison": {},

@@ -17,19 +17,20 @@ import numpy as np
 from imitwalk import curves, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.robots import Robot
-from imitwalk.sim import MujocoPlant, Rollout, SimOptions, make_plant, playback, run
-from imitwalk.trust import LABELS
+from imitwalk.sim import MujocoPlant, Rollout, SimOptions, make_plant, run
 
 __all__ = [
     "Replays",
     "ReportSettings",
     "gyro_until_fall",
     "human_strip",
+    "kick_strip",
     "outcome",
     "pose_qpos",
     "replay",
     "robot_strip",
     "save_strip",
+    "summary_phrase",
     "video",
 ]
 
@@ -70,35 +71,18 @@ def outcome(ro: Rollout) -> str:
     return f"{fell}; torso moved {d[0]:+.2f} m along x, {d[1]:+.2f} m along y in {ro.seconds:.1f} s"
 
 
-def gain(metrics: dict) -> str:
-    """The channel gain, cadence and channel offset of a run's ``metrics.json``, and their
-    trials if any ran, in a phrase (the offset only if it was tried; a back-off first)."""
-    parts = []
-    back = metrics.get("back_off") or {}
-    if back and back["scale"] != back["from"]:
-        fell = [c for c in back.get("consolidation", []) if c["falls"]]
-        why = ", ".join(f"{c['falls']} of {c['robots']} at {c['scale']:g}" for c in fell)
-        why = f" (its consolidation fell on {why})" if why else ""
-        parts.append(f"backed off from scale {back['from']:g} to {back['scale']:g}{why}")
-    for key, label in LABELS.items():
-        if key == "offset":  # one round of trials per scale where they ran, if any
-            kept = metrics.get("channel_offset") or {}
-            rounds = metrics.get("offset_trials") or []
-            if kept or rounds:
-                value = ", ".join(f"{c} {v:g}" for c, v in kept.items()) or "none"
-                parts.append(f"{label} {value}" + "".join(_trials(t, key) for t in rounds))
-            continue
-        value = metrics.get("channel_gain" if key == "gain" else key, 1.0)
-        trials = metrics.get(f"{key}_trials")
-        parts.append(f"{label} {value:g}" + (_trials(trials, key) if trials else ""))
-    return "; ".join(parts)
-
-
-def _trials(trials: dict, key: str) -> str:
-    """One round of trials (a :class:`imitwalk.trust.GainChoice` as a dict) in words."""
-    rows = ", ".join(f"{r[key]:g}: {r['falls']} fell" for r in trials["table"])
-    where = f"at scale {trials['scale']:g} " if "scale" in trials else ""
-    return f" (trials {where}on {len(trials['seeds'])} robots: {rows})"
+def summary_phrase(metrics: dict) -> str:
+    """What a run's ``metrics.json`` kept, in a phrase: a per-tick run's trial-picked
+    gains and the fraction of its model-based law; a faithful run's scales."""
+    gains = metrics.get("feedback_gains")
+    if gains is None:
+        return f"{metrics.get('iterations')} iterations of the paper's learner"
+    names = {"pitch": "gyro_y → ankle pitch", "roll": "gyro_x → ankle roll",
+             "heading": "heading → hip yaw"}  # fmt: skip
+    kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
+    trust = metrics.get("trust")
+    learned = "" if trust is None else f"; model-based law kept at {trust:g}"
+    return f"trial-picked gains {kept}{learned}"
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
@@ -176,7 +160,8 @@ class Replays:
     """The report's two runs from standing at one scale (nominal robot).
 
     ``before``: the reference played open loop; ``after``: the learned controller;
-    ``actions``: ``(T, 3)`` the (φ, r, h) it executed in the gait loop, up to its fall.
+    ``actions``: ``(T, 3)`` the (φ, r, h) it executed in the gait loop, up to its fall
+    (a faithful run's; empty for a per-tick run, whose actions are joint offsets).
     """
 
     scale: float
@@ -203,24 +188,47 @@ class Replays:
         return [("before: open loop", self.before), ("after: learned", self.after)]
 
 
-def replay(lg, robot: Robot, seconds: float, scale: float | None = None) -> Replays:
+def replay(run_, robot: Robot, seconds: float, scale: float | None = None, options=None):
     """Run the open-loop reference and the learned controller of a loaded run
-    (:func:`~imitwalk.evaluate.load_gait`) for ``seconds`` [s] at ``scale`` (default:
-    the scale reached) on the engine it learned on, without stopping at a fall; they
-    start as in :mod:`imitwalk.evaluate`."""
-    scale = lg.scale if scale is None else scale
-    q_ref = lg.ref.trajectory(scale, seconds)  # (T, n)
-    engine = lg.config.engine  # the run's own engine; the video is drawn by MuJoCo
-    opts = lg.ref.sim_options()  # on the ground the gait was built for
-    plant = make_plant(robot, opts, engine)
-    before = playback(plant, q_ref, q0=q_ref[0], stop_on_fall=False)
-    policy = lg.policy(robot, scale)
-    after = run(make_plant(robot, opts, engine), policy, len(q_ref), stop_on_fall=False)
-    actions = np.asarray(policy.tick_actions, dtype=float).reshape(-1, 3)  # (T', 3)
-    if after.fell:
+    (:func:`~imitwalk.replay.load_run`) for ``seconds`` [s] at ``scale`` (default: the
+    scale reached) on the engine it learned on, without stopping at a fall; ``options``:
+    the robot (default: the nominal one, on the ground the gait was built for)."""
+    scale = run_.scale if scale is None else scale
+    opts = run_.ref.sim_options(options)
+    runs = []
+    for name in ("open_loop", "learned"):
+        policy = run_.policy(name, robot, scale, seconds)
+        plant = make_plant(robot, opts, run_.engine)
+        steps = round(seconds / run_.ref.dt)
+        runs.append((run(plant, policy, steps, stop_on_fall=False), policy))
+    (before, _), (after, policy) = runs
+    actions = np.asarray(getattr(policy, "tick_actions", []), dtype=float).reshape(-1, 3)
+    if after.fell and len(actions):
         first = policy.first_loop_tick
         actions = actions[: max(0, round(after.fall_time / after.control_dt) - first)]
     return Replays(scale, before, after, actions)
+
+
+def kick_strip(renderer, run_, robot: Robot, count: int):
+    """One kick, rendered: the learned controller on the nominal robot kicked to the left
+    at the left heel strike two cycles after the start-up, by half the hard protocol's
+    largest kick; ``count`` images over the 1.5 s after it. Returns (figure, caption)."""
+    from imitwalk.pushes import kick_time, top_speed
+
+    ref, speed = run_.ref, 0.25 * top_speed(robot.height)
+    t = kick_time(ref, 0)
+    heading = float(ref.track(run_.scale, t + ref.dt)[-1, 2])
+    dv = (t, -speed * np.sin(heading), speed * np.cos(heading))
+    seconds = t + 1.5
+    opts = ref.sim_options(SimOptions(pushes=(dv,)))
+    policy = run_.policy("learned", robot, run_.scale, seconds)
+    ro = run(make_plant(robot, opts, run_.engine), policy, round(seconds / ref.dt), False)
+    idx = np.linspace(round(t / ref.dt), len(ro.qpos) - 1, count).astype(int)
+    images = [renderer.frame(ro.qpos[i]) for i in idx]
+    titles = [f"t = {ro.t[i]:.2f} s" for i in idx]
+    label = f"learned controller, kicked {speed:.2f} m/s to the left at t = {t:.2f} s"
+    fig = plots.film_strip(images, titles, label)
+    return fig, f"A kick of {speed:.2f} m/s to the left; the robot {outcome(ro)}."
 
 
 def save_strip(figs, path: Path) -> Path:

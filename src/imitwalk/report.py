@@ -3,10 +3,11 @@
 :func:`write_report` replays the run at the scale it reached from standing, twice (the
 open-loop reference, "before", and the learned controller, "after", nominal robot),
 renders both offscreen and writes ``RUN_DIR/report.html`` with the paper's figures
-(3, 4, 6, 7 and 8), the learning curves, the gyro traces, the evaluation metrics, the
-robustness grid and the configuration. Figures are inline base64 PNGs and the
-before/after video an inline base64 H.264 MP4: no external URL, no JavaScript. The video
-and the Fig. 8 film strip are also saved as ``before_after.mp4`` and ``filmstrip.png``.
+(3, 4, 6, 7 and 8), the learning curves, the gyro traces, the judgements on every
+protocol the run was evaluated on, push recovery with a film strip of one kick, and the
+configuration. Figures are inline base64 PNGs and the before/after video an inline
+base64 H.264 MP4: no external URL, no JavaScript. The video and the Fig. 8 film strip
+are also saved as ``before_after.mp4`` and ``filmstrip.png``.
 """
 
 from __future__ import annotations
@@ -17,9 +18,10 @@ import json
 import time
 from pathlib import Path
 
-from imitwalk import curves, media, plots
-from imitwalk.evaluate import load_gait
+from imitwalk import curves, media, plots, tables
 from imitwalk.fileio import atomic_write
+from imitwalk.gait import GaitConfig, GaitModel
+from imitwalk.replay import load_run
 from imitwalk.robots import Robot, load_robot
 from imitwalk.runs import RunDir
 
@@ -45,38 +47,6 @@ def _fmt(v) -> str:
     if v is None:
         return "–"
     return html.escape(str(v))
-
-
-def _metrics_table(ev: dict, source: str = "evaluation.json") -> str:
-    learned, open_loop = ev.get("learned", {}), ev.get("open_loop", {})
-    rows = []
-    for k in learned:
-        if k == "per_seed":
-            continue
-        v, w = learned[k], open_loop.get(k)
-        if k == "falls":
-            v, w = f"{v} of {learned.get('seeds')}", f"{w} of {open_loop.get('seeds')}"
-        rows.append(f"<tr><th>{html.escape(k)}</th><td>{_fmt(v)}</td><td>{_fmt(w)}</td></tr>")
-    st = ev.get("settings", {})
-    note = ", ".join(f"{html.escape(str(k))} = {html.escape(str(v))}" for k, v in st.items())
-    return (
-        f"<p>From <code>{html.escape(source)}</code> ({note}); per-seed values are "
-        "mean (min … max).</p><table><tr><th></th><th>learned</th><th>open loop</th></tr>"
-        + "".join(rows)
-        + "</table>"
-    )
-
-
-def _robustness_table(rob: dict) -> str:
-    rows = []
-    for name, c in rob.get("cells", {}).items():
-        cells = "".join(
-            f"<td>{c[m]['survived']}/{c[m]['of']}, {c[m]['distance_m']:.2f} m</td>"
-            for m in ("learned", "open_loop")
-        )
-        rows.append(f"<tr><th>{html.escape(name)}</th>{cells}</tr>")
-    head = "<table><tr><th>cell</th><th>learned</th><th>open loop</th></tr>"
-    return head + "".join(rows) + "</table>"
 
 
 STYLE = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}
@@ -118,12 +88,13 @@ def write_report(
     s = settings or media.ReportSettings()
     t0 = time.perf_counter()
     rd = RunDir(run_dir)
-    lg = load_gait(run_dir)
+    lg = load_run(run_dir)
     config = rd.read_json("config.json")
     where = lg.ref.settings.get("robot") or config.get("robot", lg.ref.robot)  # a file, or a name
     robot = robot or load_robot(where, lg.ref.settings.get("joint_map"))
     say(f"report: replaying {seconds:g} s at scale {lg.scale:g} (open loop, learned)")
     rp = media.replay(lg, robot, seconds)
+    gait = _display_gait(lg)
 
     say("report: rendering the video")
     from imitwalk.render import Renderer, write_mp4
@@ -142,21 +113,23 @@ def write_report(
         strips = [
             media.robot_strip(renderer, ro, lg.ref.period, s.strip_frames) for _, ro in rp.runs
         ]
-        ticks = plots.example_ticks(lg.gait.n_ticks, s.strip_frames)
-        loop = lg.gait.ref.at_scale(rp.scale)[1]  # (N, n), at the learned cadence
+        ticks = plots.example_ticks(gait.n_ticks, s.strip_frames)
+        loop = lg.ref.at_scale(rp.scale)[1]  # (N, n)
         poses = [renderer.frame(media.pose_qpos(robot, loop[k])) for k in ticks]
+        say("report: replaying and rendering one kick")
+        kick = media.kick_strip(renderer, lg, robot, s.strip_frames)
     finally:
         renderer.close()
 
     say("report: drawing figures")
     fig8 = _fig8(lg.ref, rp, strips, s.strip_frames, rd.file("filmstrip.png"))
-    body = _sections(rd, lg, rp, config, video, fig8, poses, ticks)
+    body = _sections(rd, lg, gait, rp, config, video, fig8, poses, ticks, kick)
     title = html.escape(f"imitwalk run {rd.path.name}")
     m = lg.metrics
     page = (
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}'
         f'</title><link rel="icon" href="data:,"><style>{STYLE}</style></head><body>\n'
-        f"<h1>{title}</h1>\n<p>{html.escape(str(m.get('variant', '')))} variant; scale "
+        f"<h1>{title}</h1>\n<p>{html.escape(lg.learner)} learner; scale "
         f"reached {lg.scale:g}; {m.get('iterations')} learning iterations; report made in "
         f"{time.perf_counter() - t0:.0f} s.</p>\n{body}</body></html>\n"
     )
@@ -186,30 +159,70 @@ def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
     )
 
 
-def _sections(
-    rd: RunDir, lg, rp: media.Replays, config: dict, video: str, fig8: str, poses, ticks
-) -> str:
-    gait, scale, log, m = lg.gait, rp.scale, rd.read_log(), lg.metrics
-    passed = [float(p) for p in m.get("scales_passed", [])]
-    at_final = bool(passed) and abs(lg.scale - scale) < 1e-9  # lg.scale: the scale reached
-    evr = gait.subspace.explained_variance_ratio_
-    if rd.exists("evaluation.json"):
-        evaluation = _metrics_table(rd.read_json("evaluation.json"))
-    else:
-        evaluation = (
-            '<p class="missing">No <code>evaluation.json</code>: run '
-            "<code>imitwalk evaluate RUN</code>.</p>"
+def _display_gait(lg) -> GaitModel:
+    """The paper's representation of the run's reference, for Figs. 3, 4, 6 and 7: the
+    faithful run's own; for a per-tick run, the paper's (k = 3, the angle as the phase)
+    over the schedule's scales."""
+    if lg.gait is not None:
+        return lg.gait.gait
+    cfg = lg.metrics.get("config", {})
+    start, step = float(cfg.get("start", 0.3)), float(cfg.get("step", 0.1))
+    n = int(round((lg.scale - start) / step)) + 1 if lg.scale >= start else 1
+    scales = sorted({round(start + i * step, 6) for i in range(max(n, 1))} | {lg.scale})
+    return GaitModel(lg.ref, scales, GaitConfig())
+
+
+def _evaluations(rd: RunDir) -> str:
+    found = sorted(p.name for p in rd.path.glob("protocol_*.json"))
+    if not found:
+        return (
+            '<p class="missing">No <code>protocol_*.json</code>: run '
+            "<code>imitwalk evaluate RUN --protocol eval</code> (or hard, bullet).</p>"
         )
-    for other in ("evaluation_bullet.json", "evaluation_mujoco.json"):  # the other engine
-        if rd.exists(other):
-            evaluation += _metrics_table(rd.read_json(other), other)
+    return "".join(tables.protocol_table(rd.read_json(name)) for name in found)
+
+
+def _robustness(rd: RunDir, kick: tuple) -> str:
+    strip, caption = kick
+    body = _figure(_img(strip, "a kick"), caption)
+    if not rd.exists("push_recovery.json"):
+        return body + (
+            '<p class="missing">No <code>push_recovery.json</code>: run '
+            "<code>imitwalk evaluate RUN --push-recovery</code>.</p>"
+        )
+    res = rd.read_json("push_recovery.json")
+    return _img(curves.push_polar(res), "push recovery") + tables.push_table(res) + body
+
+
+def _sections(
+    rd: RunDir, lg, gait, rp: media.Replays, config: dict, video, fig8, poses, ticks, kick
+) -> str:
+    scale, log, m = rp.scale, rd.read_log(), lg.metrics
+    passed = [float(p) for p in m.get("scales_passed", [])]
+    at_final = bool(passed) and abs(lg.scale - scale) < 1e-9
+    evr = gait.subspace.explained_variance_ratio_
     gyro = curves.gyro_traces(
         media.gyro_until_fall(rp.before),
         media.gyro_until_fall(rp.after),
         rp.before.control_dt,
         fall_times=(rp.before.fall_time, rp.after.fall_time),
     )
-    fig7 = plots.fig7_schedule(gait, passed, rp.actions if at_final else None, lg.scale)
+    learning = curves.tick_curves(log) if lg.laws is not None else curves.learning_curves(log)
+    actions = rp.actions if (at_final and len(rp.actions)) else None
+    fig7 = plots.fig7_schedule(gait, passed, actions, lg.scale)
+    fig6 = (
+        plots.fig6_optimized(gait, scale, rp.actions, rp.postures(gait))
+        if len(rp.actions)
+        else plots.fig7_schedule(gait, [], None, lg.scale)
+    )
+    fig6_caption = (
+        "The actions (φ, r, h) the learned controller executed in the replay above (red, up "
+        "to its fall, if it fell); in green, the joint targets it actually sent, projected "
+        "into the subspace."
+        if len(rp.actions)
+        else "A per-tick run acts on the legs' joints, beside the paper's (φ, r, h): "
+        "its actions have no place in this figure; the loop is drawn at the scale reached."
+    )
     sections = [
         (
             "Before and after",
@@ -218,13 +231,15 @@ def _sections(
             f"Learned: {media.outcome(rp.after)}.</p>",
         ),
         ("Fig. 8: learning to walk through imitation", fig8),
-        ("Evaluation", evaluation),
+        ("Evaluation", _evaluations(rd)),
+        ("Robustness", _robustness(rd, kick)),
         (
             "Learning",
             _figure(
-                _img(curves.learning_curves(log), "learning curves"),
-                f"{len(log)} iterations; {m.get('sim_seconds_used_for_learning')} s simulated; "
-                f"scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}; {media.gain(m)}.",
+                _img(learning, "learning curves"),
+                f"{m.get('iterations')} iterations; {m.get('sim_seconds_used_for_learning'):.0f} "
+                f"s simulated; scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}; "
+                f"{html.escape(media.summary_phrase(m))}.",
             ),
         ),
         (
@@ -259,25 +274,15 @@ def _sections(
                 "The frame of eq. 1 and g(φ) of eq. 2.",
             ),
         ),
-        (
-            "Fig. 6: optimised pattern",
-            _figure(
-                _img(plots.fig6_optimized(gait, scale, rp.actions, rp.postures(gait)), "Fig. 6"),
-                "The actions (φ, r, h) the learned controller executed in the replay above "
-                "(red, up to its fall, if it fell); in green, the joint targets it actually "
-                "sent, projected into the subspace: they include the balance channels, which "
-                "act beside the subspace.",
-            ),
-        ),
+        ("Fig. 6: optimised pattern", _figure(_img(fig6, "Fig. 6"), fig6_caption)),
         (
             "Fig. 7: motion pattern scaling",
             _figure(
                 _img(fig7, "Fig. 7"),
-                "The schedule's "
-                "scales; red circles: the last cycle the learned controller executed above.",
+                "The schedule's scales; red circles: the last cycle the learned "
+                "controller executed above (a faithful run's).",
             ),
         ),
-        ("Robustness", _robustness(rd)),
         (
             "Configuration",
             "<details><summary>config.json</summary><pre>"
@@ -286,13 +291,3 @@ def _sections(
         ),
     ]
     return "".join(_section(t, b) for t, b in sections)
-
-
-def _robustness(rd: RunDir) -> str:
-    if not rd.exists("robustness.json"):
-        return (
-            '<p class="missing">No <code>robustness.json</code>: run '
-            "<code>imitwalk evaluate RUN --perturb</code>.</p>"
-        )
-    rob = rd.read_json("robustness.json")
-    return _img(curves.robustness_heatmap(rob), "robustness") + _robustness_table(rob)

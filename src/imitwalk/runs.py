@@ -39,6 +39,19 @@ class RunDir:
     def __init__(self, path: str | Path):
         self.path = Path(path)
 
+    def check_writable(self) -> None:
+        """Refuse, before any work starts, a folder that cannot be one: a path that is a
+        file, or one whose nearest existing parent is not a writable folder."""
+        import os
+
+        if self.path.exists() and not self.path.is_dir():
+            raise RunError(f"{self.path} is a file, not a run folder; choose another --out")
+        parent = self.path
+        while not parent.exists():
+            parent = parent.parent
+        if not parent.is_dir() or not os.access(parent, os.W_OK):
+            raise RunError(f"cannot write a run folder under {parent}; choose another --out")
+
     def file(self, name: str) -> Path:
         """Path of a file in the run folder."""
         return self.path / name

@@ -21,13 +21,8 @@ from imitwalk.errors import RetargetError
 from imitwalk.retarget.plan import LegGeometry, TaskPlan
 from imitwalk.robots import Robot
 from imitwalk.robots.tree import Tree, footprint
-from imitwalk.stepconfig import TASK_OFFSETS
 
-__all__ = ["CHANNELS", "IKResult", "WalkIK", "leg_geometry"]
-
-#: Task-space offsets the IK can add to a plan's targets (see :meth:`WalkIK.solve_tick`):
-#: the ones the balance channels write (:data:`imitwalk.stepconfig.TASK_OFFSETS`).
-CHANNELS = TASK_OFFSETS
+__all__ = ["IKResult", "WalkIK", "leg_geometry"]
 
 
 def _frame(model: mujoco.MjModel, name: str) -> tuple[str, int]:
@@ -162,8 +157,8 @@ class WalkIK:
         self.posture = mink.PostureTask(m, cost=cost)
         self.limits = [mink.ConfigurationLimit(m)]
 
-    def _targets(self, plan: TaskPlan, i: int, base: np.ndarray, offset: np.ndarray) -> None:
-        """Set every task's target for tick ``i``; ``offset`` is ``(10,)`` in :data:`CHANNELS`."""
+    def _targets(self, plan: TaskPlan, i: int, base: np.ndarray) -> None:
+        """Set every task's target for tick ``i``."""
         r, cfg = self.robot, self.cfg
         target_q = cfg.q.copy()
         for role, val in plan.upper.items():
@@ -173,14 +168,12 @@ class WalkIK:
         self.posture.set_target(target_q)
         yaw = np.zeros(2) if plan.yaw is None else plan.yaw[i]  # the soles'
         walk = 0.0 if plan.path is None else plan.path[i, 2]  # the walking frame's heading
-        heading = _rz(walk)[:2, :2]  # the channels' offsets are in the walking frame
         for k, (s, sole) in enumerate((("l", plan.l_sole), ("r", plan.r_sole))):
-            dx, dy, dyaw = offset[3 * k : 3 * k + 3]
             pose = np.eye(4)
-            pose[:3, :3] = _rz(yaw[k] + dyaw) @ self._sole_rot[s]
-            pose[:3, 3] = sole[i] + np.r_[heading @ np.array([dx, dy]), offset[8 + k]]
+            pose[:3, :3] = _rz(yaw[k]) @ self._sole_rot[s]
+            pose[:3, 3] = sole[i]
             self.tasks[s].set_target(mink.SE3.from_matrix(pose))
-        com = plan.com[i] + heading @ np.array([offset[7], offset[6]])
+        com = plan.com[i]
         self.com.set_target(np.array([com[0], com[1], 0.0]))
         pelvis = np.eye(4)
         pitch = float(plan.pitch)
@@ -202,15 +195,6 @@ class WalkIK:
         """Warm-start the solver from a whole-body state ``(nq,)``."""
         self.cfg.update(np.asarray(qpos, dtype=float).copy())
 
-    def solve_tick(
-        self, plan: TaskPlan, i: int, offset: np.ndarray, max_iter: int = 10
-    ) -> np.ndarray:
-        """Joint angles ``(n,)`` [rad] for tick ``i`` of ``plan`` with task ``offset`` ``(10,)``
-        (:data:`CHANNELS`), warm-started from the previous call."""
-        self._targets(plan, i, self.robot.stand, np.asarray(offset, dtype=float))
-        self._converge(max_iter)
-        return self.cfg.q[self._qadr] * self.robot.signs
-
     def solve(self, plan: TaskPlan, q_upper_base: np.ndarray | None = None) -> IKResult:
         """Solve every tick of ``plan``.
 
@@ -225,9 +209,8 @@ class WalkIK:
         n = len(plan.phase)
         out_q, out_qpos = np.zeros((n, r.dof)), np.zeros((n, m.nq))
         res, drop, iters = np.zeros(n), np.zeros(n), np.zeros(n, dtype=int)
-        zero = np.zeros(len(CHANNELS))
         for i in range(n):
-            self._targets(plan, i, base, zero)
+            self._targets(plan, i, base)
             iters[i] = self._converge(self.max_iter)
             d = cfg.data
             errs = [
