@@ -1,12 +1,13 @@
-"""The controller in the loop: physics steps per second with each controller, over bare
-``mj_step`` measured in the same run (so the ratio holds on a noisy machine).
+"""The controller in the loop: physics steps per second with each controller of a run,
+over bare ``mj_step`` measured in the same run (so the ratios hold on a noisy machine),
+and each controller's per-tick decision time.
 
-Controllers: open-loop playback; the paper's per-tick predictive search (faithful
-variant, a gyro model fitted on a short recorded walk); the extended variant's
-step-level balance channels (with their online IK). Decision latency of the per-tick
-search is reported too.
+Controllers: every one the run can build (a per-tick run: ``learned``, ``feedback``,
+``fixed``, ``open_loop``; a faithful run: ``learned``, the paper's predictive search,
+``open_loop``). Each walks the nominal robot for ``--seconds`` from standing at the
+scale the run reached; the trials are interleaved and the best of ``--repeat`` kept.
 
-Usage: ``python bench/controller_loop.py [--seconds 10]``
+Usage: ``python bench/controller_loop.py RUN [--seconds 10] [--repeat 3]``; prints JSON.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import platform
 import time
 
 os.environ.setdefault("IMITWALK_WORKERS", "1")
@@ -21,13 +23,9 @@ os.environ.setdefault("IMITWALK_WORKERS", "1")
 import mujoco
 import numpy as np
 
-from imitwalk.gait import GaitModel
-from imitwalk.learnconfig import preset
-from imitwalk.mocap import default_clip, load_motion
-from imitwalk.models import Models, build_policy, fit_models
-from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.replay import load_run
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, playback, run
+from imitwalk.sim import MujocoPlant, run
 
 
 def bare(robot, steps: int) -> float:
@@ -40,52 +38,61 @@ def bare(robot, steps: int) -> float:
     return steps / (time.perf_counter() - t)
 
 
-def loop(robot, policy, ticks: int) -> float:
-    plant = MujocoPlant(robot)
+class Timed:
+    """A policy whose every decision is timed."""
+
+    def __init__(self, policy):
+        self.policy, self.q0, self.ms = policy, policy.q0, []
+
+    def __call__(self, k, obs):
+        t = time.perf_counter()
+        out = self.policy(k, obs)
+        self.ms.append(1e3 * (time.perf_counter() - t))
+        return out
+
+
+def loop(robot, lr, name: str, seconds: float) -> tuple[float, float]:
+    """(physics steps per second with the controller in the loop, median decision [ms])."""
+    plant = MujocoPlant(robot, lr.ref.sim_options())
+    pol = Timed(lr.policy(name, robot, lr.scale, seconds))
+    ticks = round(seconds / lr.ref.dt)
     t = time.perf_counter()
-    ro = run(plant, policy, ticks, stop_on_fall=False)
-    return len(ro.t) * plant.options.substeps / (time.perf_counter() - t)
+    ro = run(plant, pol, ticks, stop_on_fall=False)
+    rate = len(ro.t) * plant.options.substeps / (time.perf_counter() - t)
+    return rate, float(np.median(pol.ms))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
+    ap.add_argument("run_dir", help="a finished run folder")
+    ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per trial")
+    ap.add_argument("--repeat", type=int, default=3, help="trials; the best is kept")
     args = ap.parse_args()
     robot = load_robot("hoap2")
-    cfg = RetargetConfig(search=False, scales=(0.5,), params=GaitParams())
-    ref = retarget(load_motion(default_clip()), robot, cfg).reference
-    ticks = round(args.seconds / ref.dt)
-    out = {"seconds": args.seconds, "control_hz": 1 / ref.dt}
-    out["bare_mj_step_per_s"] = round(bare(robot, ticks * 10))
-    q = ref.trajectory(0.5, args.seconds)
-    t = time.perf_counter()
-    playback(MujocoPlant(robot), q, q0=q[0], stop_on_fall=False)
-    out["open_loop_steps_per_s"] = round(ticks * 10 / (time.perf_counter() - t))
-    faithful = preset("faithful")
-    gait = GaitModel(ref, (0.5,), faithful.gait)
-    warm = build_policy(gait, 0.5, faithful, Models(), explore=1.0, rng_seed=0)
-    run(MujocoPlant(robot), warm, ticks, stop_on_fall=False)  # record data for the model
-    data = {"tick": [(np.asarray(warm.tick_states), np.asarray(warm.tick_actions))], "step": []}
-    models = fit_models(data, faithful)
-    pol = build_policy(gait, 0.5, faithful, models)
-    out["faithful_mpc_steps_per_s"] = round(loop(robot, pol, ticks))
-    sel = pol.selector
-    lat = []
-    s = np.zeros(3)
-    a = gait.nominal_action(0.5, 0)
-    for _ in range(300):
-        t = time.perf_counter()
-        sel.select(s, s, a)
-        lat.append(time.perf_counter() - t)
-    out["mpc_decision_ms_median"] = round(1e3 * float(np.median(lat)), 3)
-    out["mpc_candidates"] = int(np.prod(faithful.tick.grid))
-    ext = preset("extended")
-    egait = GaitModel(ref, (0.5,), ext.gait)
-    out["extended_channels_steps_per_s"] = round(
-        loop(robot, build_policy(egait, 0.5, ext, Models(), robot=robot), ticks)
-    )
-    for k in ("open_loop", "faithful_mpc", "extended_channels"):
-        out[f"{k}_over_bare"] = round(out[f"{k}_steps_per_s"] / out["bare_mj_step_per_s"], 3)
+    lr = load_run(args.run_dir)
+    names = lr.controllers()
+    steps = round(args.seconds * 1000)
+    best = {"bare": 0.0, **{n: (0.0, np.inf) for n in names}}
+    for _ in range(args.repeat):  # interleaved, so that every side sees the same machine
+        best["bare"] = max(best["bare"], bare(robot, steps))
+        for n in names:
+            rate, ms = loop(robot, lr, n, args.seconds)
+            best[n] = (max(best[n][0], rate), min(best[n][1], ms))
+    out = {
+        "run": args.run_dir,
+        "learner": lr.learner,
+        "seconds": args.seconds,
+        "machine": platform.processor() or platform.machine(),
+        "bare_mj_step_per_s": round(best["bare"]),
+        "controllers": {
+            n: {
+                "steps_per_s": round(best[n][0]),
+                "ratio_to_bare": round(best[n][0] / best["bare"], 3),
+                "decision_ms_median": round(best[n][1], 4),
+            }
+            for n in names
+        },
+    }
     print(json.dumps(out, indent=2))
 
 

@@ -167,7 +167,8 @@ class TickPolicy:
         self.laws = tuple(laws)
         self.q_ref = ref.trajectory(scale, seconds)  # (T, n)
         self.heading_ref = ref.track(scale, seconds)[:, 2]  # (T,) commanded heading [rad]
-        self.E = [channel_matrix(tuple(joint_names), law.channels) for law in self.laws]
+        names, stance = tuple(joint_names), ref.stance
+        self.E = [channel_matrix(names, law.channels, stance) for law in self.laws]  # (P, n, m)
         self.start, self.n_loop = ref.starts.shape[1], ref.loops.shape[1]
         self.pick = [[FEATURES.index(f) for f in law.features] for law in self.laws]
         self.estimator = StateEstimator(ref.dt)
@@ -211,7 +212,7 @@ class TickPolicy:
                 a = a + self._noise
             a = np.clip(a, -law.box, law.box)
             self._x_prev[j], self._a_prev[j] = x, a
-            q += self.E[j] @ a
+            q += self.E[j][i % len(self.E[j])] @ a
         self._phase.append(i)
         self._f.append(full)
         self._a.append(a)

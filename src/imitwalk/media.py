@@ -78,7 +78,7 @@ def summary_phrase(metrics: dict) -> str:
     if gains is None:
         return f"{metrics.get('iterations')} iterations of the paper's learner"
     names = {"pitch": "gyro_y → ankle pitch", "roll": "gyro_x → ankle roll",
-             "heading": "heading → hip yaw"}  # fmt: skip
+             "heading": "heading → turn"}  # fmt: skip
     kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
     trust = metrics.get("trust")
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"

@@ -194,6 +194,19 @@ class Protocol:
         dev = float(max(fractions) ** len(fractions)) if fractions else 0.0
         return tuple(out), dev
 
+    def only(self, factors) -> Protocol:
+        """This protocol with only ``factors`` drawn (the others at nominal; each kept
+        factor draws exactly as in the full protocol).
+
+        Raises:
+            ConfigError: a factor this protocol does not draw (listing the ones it does).
+        """
+        for f in factors:
+            if f not in self.factors:
+                raise unknown_name(f"factor of protocol {self.name}", f, self.factors, ConfigError)
+        kept = {f: v for f, v in self.factors.items() if f in factors}
+        return replace(self, name=f"{self.name}[{','.join(kept)}]", factors=kept)
+
     def to_dict(self) -> dict:
         """The protocol as its file holds it."""
         return {

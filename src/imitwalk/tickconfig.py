@@ -26,22 +26,27 @@ def _range(name: str, values, lo: float, hi: float) -> None:
 @dataclass(frozen=True)
 class TrialConfig:
     """The trial-picked feedback law: each gain chosen in turn from its candidates by
-    trials on training robots (fewest falls, then the longest walks before them, then
-    the least measured eq.-6 cost Γ, or for the heading gain the least |yaw drift|).
+    trials on training robots (:class:`imitwalk.ticklearn.Trial`: fewest falls where
+    robots walk, then fewest falls on hard robots and the longest walks before them,
+    then the least measured eq.-6 cost Γ, or for the heading gain the least |yaw|).
+    The signs searched follow the joints' conventions (x forward, y left, z up): a
+    positive ankle offset on a positive gyro rate pushes back against the fall.
 
     Attributes:
         pitch: candidate gains gyro_y → ankle_pitch [rad per rad/s].
         roll: candidate gains gyro_x → ankle_roll [rad per rad/s].
-        heading: candidate gains heading → hip_yaw [rad per rad].
+        heading: candidate gains heading → turn [rad of turn per step per rad of heading
+            error]; a negative gain steers back.
         box: each channel's limit [rad].
-        robots, seconds: training robots per candidate and simulated time each [s].
+        robots, seconds: robots of each protocol per candidate (``robots`` from the
+            schedule's, as many from ``trial_protocol``) and simulated time each [s].
     """
 
-    pitch: tuple[float, ...] = (-0.05, 0.0, 0.05, 0.1, 0.2)
-    roll: tuple[float, ...] = (-0.05, 0.0, 0.05, 0.1, 0.2)
-    heading: tuple[float, ...] = (0.0, 0.3, 0.6, 1.2)
+    pitch: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2)
+    roll: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2)
+    heading: tuple[float, ...] = (-1.0, -0.5, -0.25, 0.0)
     box: float = 0.15
-    robots: int = 6
+    robots: int = 4
     seconds: float = 12.0
 
     def __post_init__(self):
@@ -116,7 +121,7 @@ class TickLearnConfig:
     step: float = 0.1
     stop: float = 1.0
     iterations: int = 3
-    robots: int = 6
+    robots: int = 4
     seconds: float = 12.0
     train_protocol: str = "eval"
     trial_protocol: str = "hard"

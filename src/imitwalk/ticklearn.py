@@ -4,11 +4,10 @@ Three stages, each checkpointed, so that an interrupted run resumes where it sto
 and ends where an uninterrupted one would:
 
 1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
-   roll, heading → hip yaw, with each gain chosen in turn from its candidates by
-   trials at the top scale: fewest falls, then the longest walks before them, then the
-   least measured eq.-6 cost Γ (the balance gains, on ``trial_protocol`` robots, where
-   they fall) or the least |yaw drift| (the heading gain, on ``train_protocol`` robots,
-   where they walk the whole trial). This is the baseline; the learned law starts from it.
+   roll, heading → turn (steering: :data:`~imitwalk.channels.PHASED`), with each gain
+   chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
+   robots of the schedule's protocol and of ``trial_protocol``. This is the baseline;
+   the learned law starts from it.
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.tickmodel.PhaseModel`), turn it into gains by
@@ -16,8 +15,12 @@ and ends where an uninterrupted one would:
    a scale is passed by an iteration without exploration in which no training robot
    falls. The learned law acts on top of the trial-picked one.
 3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the top
-   scale on the trial robots; the fraction that falls least, then costs least, is kept
-   (0: the trial-picked law alone).
+   scale, on the trials' robots; the fraction that ranks best is kept (0: the
+   trial-picked law alone).
+
+The run's controllers are judged at the top scale (``scale_reached``): the trials chose
+the feedback there; ``scales_passed`` says how far the schedule carried the model-based
+law.
 
 Training robots come from ``train_protocol`` with seeds no evaluation uses.
 """
@@ -51,7 +54,7 @@ __all__ = ["TRIAL_GAINS", "TickProgress", "learn_tick", "load_laws"]
 TRIAL_GAINS = (
     ("pitch", "ankle_pitch", "gyro_y", "cost"),
     ("roll", "ankle_roll", "gyro_x", "cost"),
-    ("heading", "hip_yaw", "heading", "abs_yaw_deg"),
+    ("heading", "turn", "heading", "abs_yaw_deg"),
 )
 
 
@@ -64,6 +67,7 @@ class TickProgress:
         gains: the trial-picked gains so far, by setting name; trial: the next gain.
         scale_index, iteration: where the schedule is; passed: scales passed.
         trust: the fraction of the learned law kept (``None`` until decided).
+        tried: every candidate's trial results so far, by key (run once each).
         sim_seconds, wall_seconds: what learning has cost so far [s].
     """
 
@@ -74,6 +78,7 @@ class TickProgress:
     iteration: int = 0
     passed: list = field(default_factory=list)
     trust: float | None = None
+    tried: dict = field(default_factory=dict)
     sim_seconds: float = 0.0
     wall_seconds: float = 0.0
 
@@ -150,31 +155,72 @@ def _summary(results: list[TickResult]) -> dict:
     }
 
 
+@dataclass(frozen=True)
+class Trial:
+    """One candidate's trials at the top scale: on ``walking`` robots (the schedule's
+    protocol) and on ``hard`` ones (``trial_protocol``)."""
+
+    walking: list
+    hard: list
+
+    def rank(self, measure: str) -> tuple:
+        """Fewest falls where robots walk, then fewest falls (and the longest walks before
+        them) on the hard robots, then the least ``measure`` where robots walk for
+        ``abs_yaw_deg`` (the heading), else on the hard robots (the balance)."""
+        w, h = _rank(self.walking, measure), _rank(self.hard, measure)
+        return (w[0], h[0], h[1], w[2] if measure == "abs_yaw_deg" else h[2])
+
+    def summary(self) -> dict:
+        return {"walking": _summary(self.walking), "hard": _summary(self.hard)}
+
+
+def _trial(lr: _Learner, state: TickProgress, key: str, laws) -> Trial:
+    """The trials of ``laws`` at the top scale, run once per key (kept in the checkpoint,
+    so that a resumed run neither repeats nor re-counts them)."""
+    if key not in state.tried:
+        cfg, top = lr.cfg, lr.scales[-1]
+        n, first, seconds = cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds
+        draws = lr.robots(n, first, seconds) + lr.robots(n, first, seconds, trial=True)
+        res = lr.run(state, top, laws, draws, seconds)
+        state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
+    res = [TickResult(**r) for r in state.tried[key]]
+    half = len(res) // 2
+    return Trial(res[:half], res[half:])
+
+
+def _gains_key(gains: dict, extra: str = "") -> str:
+    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS) + extra
+
+
+def _say_table(lr: _Learner, head: str, table) -> None:
+    """One progress line: per candidate, falls walking + hard, hard seconds walked, |yaw|."""
+    cells = []
+    for v, t in table:
+        w, h = t.summary()["walking"], t.summary()["hard"]
+        cells.append(
+            f"[{v:g}: {w['falls']}+{h['falls']} fell, {h['walked_s']:.0f} s, "
+            f"{w['abs_yaw_deg']:.1f} deg]"
+        )
+    lr.say(f"{head} {' '.join(cells)}")
+
+
 def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
     """Stage 1: one gain at a time, each from its candidates, at the top scale."""
-    cfg, top = lr.cfg, lr.scales[-1]
-    n, first, seconds = cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds
-    hard, walking = lr.robots(n, first, seconds, trial=True), lr.robots(n, first, seconds)
+    cfg = lr.cfg
     while state.trial < len(TRIAL_GAINS):
         name, channel, feature, measure = TRIAL_GAINS[state.trial]
-        # the heading is judged where the robots walk the whole trial; balance, where they fall
-        draws = walking if measure == "abs_yaw_deg" else hard
         table = []
         for value in getattr(cfg.trials, name):
             gains = {**state.gains, name: float(value)}
-            res = lr.run(state, top, [_feedback_law(cfg, gains)], draws, cfg.trials.seconds)
-            table.append((_rank(res, measure), float(value), _summary(res)))
-        best = min(table, key=lambda row: (row[0], abs(row[1])))
-        state.gains[name] = best[1]
+            laws = [_feedback_law(cfg, gains)]
+            table.append((float(value), _trial(lr, state, _gains_key(gains), laws)))
+        best = min(table, key=lambda row: (row[1].rank(measure), abs(row[0])))[0]
+        state.gains[name] = best
         log.append(
             {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
-             "kept": best[1], "table": [{"value": v, **s} for _, v, s in table]}
+             "kept": best, "table": [{"value": v, **t.summary()} for v, t in table]}
         )  # fmt: skip
-        lr.say(
-            f"trials: {feature} -> {channel} = {best[1]:g} "
-            + " ".join(f"[{v:g}: {s['falls']}/{s['robots']} fell, {s['walked_s']:.0f} s, "
-                       f"{s['cost']:.3f}, {s['abs_yaw_deg']:.1f} deg]" for _, v, s in table)
-        )  # fmt: skip
+        _say_table(lr, f"trials: {feature} -> {channel} = {best:g}", table)
         state.trial += 1
         _checkpoint(lr, state, log)
     state.stage = "schedule" if cfg.lqr.enabled else "done"
@@ -238,29 +284,23 @@ def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> Feedb
 
 
 def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
-    """Stage 3: how much of the learned law to keep, by trials at the scale reached."""
+    """Stage 3: how much of the learned law to keep, by the trials at the top scale (the
+    law the schedule learned at the highest scale it passed)."""
     cfg = lr.cfg
-    if learned is None or not state.passed:
+    if learned is None:
         state.trust, state.stage = 0.0, "done"
         return
-    scale = max(state.passed)
-    draws = lr.robots(cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds, trial=True)
     base = _feedback_law(cfg, state.gains)
     table = []
     for frac in cfg.lqr.trust:
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
-        res = lr.run(state, scale, laws, draws, cfg.trials.seconds)
-        table.append((_rank(res), float(frac), _summary(res)))
-    best = min(table, key=lambda row: (row[0], row[1]))
-    state.trust, state.stage = best[1], "done"
-    log.append({"stage": "trust", "scale": scale, "kept": best[1],
-                "table": [{"fraction": f, **s} for _, f, s in table]})  # fmt: skip
-    lr.say(
-        f"trust at {scale:g}: kept {best[1]:g} "
-        + " ".join(
-            f"[{f:g}: {s['falls']}/{s['robots']} fell, {s['cost']:.3f}]" for _, f, s in table
-        )
-    )
+        key = _gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
+        table.append((float(frac), _trial(lr, state, key, laws)))
+    best = min(table, key=lambda row: (row[1].rank("cost"), row[0]))[0]
+    state.trust, state.stage = best, "done"
+    log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
+                "table": [{"fraction": f, **t.summary()} for f, t in table]})  # fmt: skip
+    _say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
 
 
 def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None = None) -> None:
@@ -359,7 +399,7 @@ def learn_tick(
         _checkpoint(lr, state, log, data)
     summary = {
         "learner": "tick",
-        "scale_reached": max(state.passed) if state.passed else lr.scales[-1],
+        "scale_reached": lr.scales[-1],
         "scales_passed": state.passed,
         "feedback_gains": state.gains,
         "trust": state.trust,

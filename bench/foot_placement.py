@@ -1,0 +1,90 @@
+"""Does per-tick swing-foot placement help against kicks? A measurement, not a product option.
+
+On top of a per-tick run's learned controller, a law moves the swing leg every tick:
+its hip roll by ``k_roll × gyro_x`` (the ankle roll by the opposite, to keep the foot
+flat) and its hip pitch by ``k_pitch × gyro_y`` (ankle pitch opposite), on the leg
+the reference has in swing at that tick. Each gain is tried on the same robots of a
+protocol reduced to one factor (``--factor pushes`` by default) and on the full one.
+The gains are swept here, on robots the learner never used; none is kept by imitwalk
+(docs/RESULTS.md, "Foot placement").
+
+Usage: ``python bench/foot_placement.py RUN [--seeds 20] [--factor pushes]``; prints JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+
+from imitwalk.feedback import FeedbackLaw
+from imitwalk.parallel import run_parallel
+from imitwalk.protocol import load_protocol
+from imitwalk.replay import load_run
+from imitwalk.robots import load_robot
+from imitwalk.tickrun import TickJob, run_tick_episode
+
+GAINS = (-0.3, -0.15, 0.15, 0.3)
+CHANNELS = ("l_hip_roll", "r_hip_roll", "l_ankle_roll", "r_ankle_roll",
+            "l_hip_pitch", "r_hip_pitch", "l_ankle_pitch", "r_ankle_pitch")  # fmt: skip
+
+
+def swing_law(stance: np.ndarray, k_roll: float, k_pitch: float) -> FeedbackLaw:
+    """The swing-leg law of the module doc, per loop tick of ``stance`` ``(N, 2)``."""
+    swing = (~np.asarray(stance, dtype=bool)).astype(float)  # (N, 2) left, right
+    g = np.zeros((len(swing), len(CHANNELS), 2))
+    for leg in range(2):
+        g[:, leg, 0], g[:, 2 + leg, 0] = k_roll * swing[:, leg], -k_roll * swing[:, leg]
+        g[:, 4 + leg, 1], g[:, 6 + leg, 1] = k_pitch * swing[:, leg], -k_pitch * swing[:, leg]
+    return FeedbackLaw(CHANNELS, ("gyro_x", "gyro_y"), g, np.zeros((1, 2)), np.full(8, 0.3))
+
+
+def falls(run, robot, laws, protocol, seeds: int) -> dict:
+    ref = run.ref
+    draws = [protocol.draw(s, robot, ref.sim_options(), 30.0) for s in range(seeds)]
+    jobs = [
+        TickJob(
+            run.path + "/reference.npz",
+            robot,
+            run.scale,
+            tuple(laws),
+            d.seed,
+            d.options,
+            30.0,
+            engine=protocol.engine,
+            record=False,
+        )
+        for d in draws
+    ]
+    res = run_parallel(run_tick_episode, jobs)
+    return {"falls": int(sum(r.fell for r in res)), "robots": len(res),
+            "distance_m": float(np.mean([r.distance_m for r in res]))}  # fmt: skip
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("run_dir", help="a per-tick run folder")
+    ap.add_argument("--seeds", type=int, default=20, help="robots per protocol")
+    ap.add_argument("--factor", default="pushes", help="the one factor of the reduced protocol")
+    args = ap.parse_args()
+    robot = load_robot("hoap2")
+    run = load_run(args.run_dir)
+    hard = load_protocol("hard")
+    protocols = {args.factor: hard.only((args.factor,)), "hard": hard}
+    base = run.laws["learned"]
+    out = {"run": args.run_dir, "seeds": args.seeds, "results": []}
+    variants = [("learned", 0.0, 0.0)]
+    variants += [("swing roll", k, 0.0) for k in GAINS] + [("swing pitch", 0.0, k) for k in GAINS]
+    for name, kr, kp in variants:
+        laws = base if name == "learned" else (*base, swing_law(run.ref.stance, kr, kp))
+        row = {"law": name, "k_roll": kr, "k_pitch": kp}
+        row.update(
+            {p: falls(run, robot, laws, proto, args.seeds) for p, proto in protocols.items()}
+        )
+        out["results"].append(row)
+    print(json.dumps(out, indent=2))
+
+
+if __name__ == "__main__":
+    main()
