@@ -7,6 +7,11 @@ from pathlib import Path
 
 import pytest
 
+# MuJoCo reads MUJOCO_GL when it is first imported. imitwalk sets it (offscreen on the CPU)
+# when it is imported, but a test module may import mujoco first (test_bullet.py, the first
+# collected): without this the report's renderer would get GLFW and no display.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 #: Settings of a tiny faithful learning run (two scales, two short iterations each, one
 #: process).
 TINY = [
