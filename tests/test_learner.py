@@ -46,6 +46,7 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
     assert strip_wall(resumed) == strip_wall(whole)
     log_w = [e["falls"] for e in RunDir(tmp_path / "whole").read_log()]
     assert [e["falls"] for e in rd.read_log()] == log_w
+    assert strip_log(rd.read_log()) == strip_log(RunDir(tmp_path / "whole").read_log())
     # the same training robots after a resume, the nominal one first
     seeds = [e["seeds"] for e in rd.read_log()]
     assert seeds == [e["seeds"] for e in RunDir(tmp_path / "whole").read_log()]
