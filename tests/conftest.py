@@ -7,25 +7,50 @@ from pathlib import Path
 
 import pytest
 
-#: Settings of a tiny learning run (two scales, two short iterations each, one process).
+# MuJoCo reads MUJOCO_GL when it is first imported. imitwalk sets it (offscreen on the CPU)
+# when it is imported, but a test module may import mujoco first (test_bullet.py, the first
+# collected): without this the report's renderer would get GLFW and no display.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+#: Settings of a tiny faithful learning run (two scales, two short iterations each, one
+#: process).
 TINY = [
     "schedule.start=0.3",
     "schedule.stop=0.4",
     "schedule.iterations=2",
     "schedule.seconds=6",
-    "gain_robots=2",
-    "gain_seconds=4",
+    "workers=1",
+]
+
+#: Settings of a tiny per-tick learning run (:mod:`imitwalk.ticklearn`): scales 0.8 and 1,
+#: two training robots x 6 s, two candidates per trial-picked gain on two robots x 6 s.
+TICK = [
+    "start=0.8",
+    "step=0.2",
+    "robots=2",
+    "seconds=6",
+    "trials.robots=2",
+    "trials.seconds=6",
+    "trials.pitch=0,0.1",
+    "trials.roll=0,0.1",
+    "trials.heading=0,0.3",
     "workers=1",
 ]
 
 
+def sets(settings: list[str]) -> list[str]:
+    """``--set`` arguments for ``settings``."""
+    return [a for s in settings for a in ("--set", s)]
+
+
 def strip_wall(summary: dict) -> dict:
-    """A learning summary without its wall times (the one thing a rerun may change)."""
-    out = {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
-    for key in ("gain_trials", "cadence_trials"):
-        if out.get(key):
-            out[key] = {k: v for k, v in out[key].items() if k != "wall_seconds"}
-    return out
+    """A learning summary without its wall time (the one thing a rerun may change)."""
+    return {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
+
+
+def strip_log(log: list[dict]) -> list[dict]:
+    """A learning log without its wall times."""
+    return [{k: v for k, v in e.items() if k != "wall_seconds"} for e in log]
 
 
 @pytest.fixture(scope="session")
@@ -70,3 +95,26 @@ def tiny_reference(robot, tmp_path_factory):
     path = tmp_path_factory.mktemp("ref") / "ref.npz"
     ref.save(path)
     return ref, path
+
+
+@pytest.fixture(scope="session")
+def tick_reference(tmp_path_factory) -> Path:
+    """The default clip retargeted without the parameter search (every grid scale), as
+    ``imitwalk retarget --no-search`` writes it: the reference of the per-tick tests."""
+    from imitwalk.cli import main
+
+    path = tmp_path_factory.mktemp("tickref") / "ref.npz"
+    assert main(["retarget", "--no-search", "--out", str(path)]) == 0
+    return path
+
+
+@pytest.fixture(scope="session")
+def tick_run(tick_reference, tmp_path_factory) -> Path:
+    """A finished tiny per-tick run (:data:`TICK`) learned through the CLI. Shared: a test
+    that writes into a run copies it first."""
+    from imitwalk.cli import main
+
+    out = tmp_path_factory.mktemp("tickrun") / "run"
+    argv = ["learn", "--reference", str(tick_reference), "--out", str(out), *sets(TICK)]
+    assert main(argv) == 0
+    return out

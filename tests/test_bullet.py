@@ -21,6 +21,7 @@ from imitwalk.robots import BUILTIN, load_robot
 from imitwalk.robots.urdf import to_urdf, urdf_file
 from imitwalk.sim import MujocoPlant, make_plant, playback, run
 from imitwalk.simtypes import jitter_draws
+from imitwalk.tickconfig import TickLearnConfig
 
 
 def test_urdf_carries_masses_and_frames(robot):
@@ -131,6 +132,10 @@ def test_engine_settings_are_checked():
     with pytest.raises(ConfigError, match="valid: bullet, mujoco"):
         SearchConfig(engine="physx")
     assert LearnConfig(engine="bullet").engine == "bullet"
+    with pytest.raises(ConfigError, match="engine 'physx'; valid: ") as err:
+        TickLearnConfig(engine="physx")
+    assert sorted(str(err.value).split("valid: ")[1].split(", ")) == ["bullet", "mujoco"]
+    assert TickLearnConfig(engine="bullet").engine == "bullet"
 
 
 def test_servos_without_a_force_limit(tmp_path):

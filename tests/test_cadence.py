@@ -8,7 +8,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from imitwalk.errors import ConfigError
-from imitwalk.learnconfig import preset
 from imitwalk.retarget.cadence import with_cadence
 
 
@@ -59,12 +58,6 @@ def test_an_impossible_rate_is_refused(tiny_reference, rate):
         with_cadence(ref, rate)
 
 
-def test_candidate_cadences_are_checked():
-    assert preset("extended", cadences=(1.0, 1.12)).cadences == (1.0, 1.12)
-    with pytest.raises(ConfigError, match=r"cadences: 3\.0"):
-        preset("extended", cadences=(1.0, 3.0))
-
-
 def test_retarget_can_play_the_clip_at_another_cadence(robot, tiny_reference):
     from imitwalk.mocap import default_clip, load_motion
     from imitwalk.retarget import GaitParams, RetargetConfig, retarget
@@ -85,20 +78,3 @@ def test_rates_compound_relative_to_the_human(tiny_reference):
     twice = with_cadence(with_cadence(ref, 1.12), 1.12)
     n, n3 = ref.loops.shape[1], twice.loops.shape[1]
     assert twice.settings["cadence"] == pytest.approx(n / n3)
-
-
-def test_the_step_clock_starts_at_the_loop_when_the_start_up_keeps_the_human_cadence(
-    tiny_reference,
-):
-    from imitwalk.balance import StepConfig, StepController
-    from imitwalk.gait import GaitModel
-    from imitwalk.policy import WalkPolicy
-
-    ref, _ = tiny_reference
-    for rate in (1.0, 1.12):
-        gait = GaitModel(with_cadence(ref, rate), (0.3, 0.4), preset("extended").gait)
-        n = gait.n_ticks
-        policy = WalkPolicy(gait, 0.4, steps=StepController(StepConfig(), n, 0.1))
-        m = len(policy.start)
-        # the human cadence: from the start-up's first step (it is whole loops long)
-        assert policy._clock0 == (m % n + n if rate == 1.0 else m)

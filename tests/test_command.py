@@ -241,38 +241,56 @@ def test_the_command_in_words_and_on_the_ground(turning):
     assert xy[-1, 1] > 0.1  # a left turn bends the path to +y
 
 
-def test_the_learner_sees_heading_beyond_the_commanded_turn(turning):
-    from imitwalk.gait import GaitModel
-    from imitwalk.learnconfig import preset
-    from imitwalk.policy import WalkPolicy
+def test_the_learner_sees_heading_beyond_the_commanded_turn(robot, turning):
+    from imitwalk.channels import FEATURES
+    from imitwalk.feedback import FeedbackLaw, TickPolicy
+    from imitwalk.simtypes import Observation
 
-    gait = GaitModel(turning, (0.5, 1.0), preset("extended").gait)
-    policy = WalkPolicy(gait, 1.0)
+    law = FeedbackLaw.zero(("hip_yaw",), ("heading",), 0.1)
+    policy = TickPolicy(turning, 1.0, (law,), robot.joint_names, 30.0)
     tr = turning.track(1.0, 30.0)
-    for k in (0, 150, len(policy.start) + 3, len(policy.start) + 5 * policy.n + 7):
-        assert policy.commanded_heading(k) == pytest.approx(tr[k, 2], abs=1e-9)
-    half = WalkPolicy(gait, 0.5)  # half the scale: half the turn
-    assert half.commanded_heading(2000) == pytest.approx(turning.track(0.5, 30.0)[2000, 2])
-    assert half.commanded_heading(2000) == pytest.approx(tr[2000, 2] / 2, rel=0.05)
+    n_loop = turning.loops.shape[1]
+    for k in (0, 150, policy.start + 3, policy.start + 5 * n_loop + 7):
+        assert policy.heading_ref[k] == pytest.approx(tr[k, 2], abs=1e-9)
+    half = TickPolicy(turning, 0.5, (law,), robot.joint_names, 30.0)  # half the scale: half turn
+    assert half.heading_ref[2000] == pytest.approx(turning.track(0.5, 30.0)[2000, 2])
+    assert half.heading_ref[2000] == pytest.approx(tr[2000, 2] / 2, rel=0.05)
+    # a robot whose gyro turns it exactly as commanded has no heading error; one that
+    # does not turn at all sees the whole commanded turn as its error
+    dt, h = turning.dt, FEATURES.index("heading")
+    rate = np.diff(tr[:, 2], prepend=0.0) / dt  # (T,) yaw rate that integrates to the track
+    for gz, expected in ((rate, np.zeros(len(tr))), (0.0 * rate, -tr[:, 2])):
+        p = TickPolicy(turning, 1.0, (law,), robot.joint_names, 30.0)
+        for k in range(len(tr)):
+            obs = Observation(k * dt, np.array([0, 0, gz[k]]), np.array([0, 0, 9.81]),
+                              np.zeros((2, 4)), np.zeros(len(robot.joint_names)))  # fmt: skip
+            p(k, obs)
+        np.testing.assert_allclose(p.episode().features[:, h], expected, atol=1e-9)
+    assert tr[-1, 2] > np.radians(100)  # it does turn: ~10° per cycle for 30 s
 
 
 @pytest.mark.slow
 def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     """The whole loop on a turning reference: learned, evaluated against its own path."""
-    from conftest import TINY
+    from conftest import TICK
     from imitwalk.config import apply_overrides
-    from imitwalk.evaluate import evaluate_run
-    from imitwalk.learnconfig import preset
-    from imitwalk.learner import learn
+    from imitwalk.judge import JudgeJob, run_controller
+    from imitwalk.protocol import load_protocol
+    from imitwalk.tickconfig import TickLearnConfig
+    from imitwalk.ticklearn import learn_tick
 
     cmd = GaitCommand(turn_deg=12.0)
     ref = build_walkable(template, robot, GaitParams(), [0.3, 0.4], 0.01, command=cmd).reference
-    cfg = apply_overrides(preset("extended"), [*TINY, "train_models=2"])
-    summary = learn(ref, robot, cfg, tmp_path / "run")
+    cfg = apply_overrides(TickLearnConfig(), [*TICK, "start=0.3", "step=0.1", "stop=0.4"])
+    summary = learn_tick(ref, robot, cfg, tmp_path / "run")
     assert summary["scale_reached"] is not None
-    ev = evaluate_run(tmp_path / "run", robot, seconds=10.0, seeds=2, workers=1)
-    for mode in ("learned", "open_loop"):
-        for r in ev[mode]["per_seed"]:
-            assert r["commanded_turn_deg"] > 20.0  # ~4.5° per cycle for 10 s
+    protocol = load_protocol("eval")
+    for mode in ("learned", "feedback", "open_loop"):
+        for seed in (0, 1):
+            d = protocol.draw(seed, robot, seconds=10.0)
+            job = JudgeJob(str(tmp_path / "run"), robot, mode, seed, d.options, d.furthest,
+                           10.0, None, protocol.engine)  # fmt: skip
+            r = run_controller(job)
+            assert r["commanded_turn_deg"] > 20.0  # ~4.8° per cycle for 10 s
             if not r["fell"]:  # it follows the turn: what is left is a drift, not the turn
                 assert abs(r["yaw_drift_deg"]) < r["commanded_turn_deg"] / 2

@@ -7,16 +7,17 @@ import sys
 
 #: Modules that must import without MuJoCo (directly or through another module).
 NUMPY_ONLY = (
-    "balance",
+    "channels",
     "config",
     "controller",
     "curves",
     "embedding",
-    "ensemble",
     "estimator",
+    "feedback",
     "fileio",
     "gait",
     "learnconfig",
+    "lqr",
     "metrics",
     "models",
     "perturb",
@@ -34,9 +35,10 @@ NUMPY_ONLY = (
     "retarget.template",
     "servo",
     "simtypes",
-    "stepconfig",
     "subspace",
-    "trust",
+    "tables",
+    "tickconfig",
+    "tickmodel",
 )
 
 

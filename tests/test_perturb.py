@@ -54,11 +54,3 @@ def test_a_wider_friction_range_maps_the_same_draw(seed, high):
         base.kp_jitter,
         base.init_twist,
     )
-
-
-def test_train_friction_is_checked():
-    from imitwalk.learnconfig import LearnConfig
-
-    assert LearnConfig(train_friction=(0.7, 1.3)).train_friction == (0.7, 1.3)
-    with pytest.raises(ConfigError, match="train_friction"):
-        LearnConfig(train_friction=(1.3, 0.7))

@@ -6,20 +6,34 @@ import json
 
 import pytest
 
+from conftest import TICK, sets
 from imitwalk.cli import main
+from imitwalk.tickconfig import LqrConfig, TrialConfig
 
-QUICK = [
+#: A small reference search.
+SEARCH = [
     "retarget.search_config.generations=1",
     "retarget.search_config.population=4",
     "retarget.search_config.seconds=6",
     "retarget.search_config.models=2",
-    "schedule.stop=0.5",
-    "schedule.iterations=2",
-    "schedule.seconds=8",
-    "train_models=2",
-    "gain_robots=3",
-    "gain_seconds=8",
 ]
+#: A short learning run of each variant.
+QUICK = {
+    "faithful": [
+        "schedule.stop=0.5",
+        "schedule.iterations=2",
+        "schedule.seconds=8",
+        "train_models=2",
+    ],
+    "extended": [
+        "stop=0.5",
+        "iterations=2",
+        "robots=2",
+        "seconds=8",
+        "trials.robots=3",
+        "trials.seconds=8",
+    ],
+}
 
 
 @pytest.mark.slow
@@ -29,17 +43,23 @@ def test_learn_and_evaluate_every_walk(shared_mocap, tmp_path, capsys, clip, var
     out = tmp_path / "run"
     argv = ["learn", "--out", str(out), "--variant", variant, "--json"]
     argv += [] if clip == "default" else [str(shared_mocap / clip)]
-    argv += [a for s in QUICK for a in ("--set", s)]
+    argv += sets([*SEARCH, *QUICK[variant]])
     assert main(argv) == 0
     learned = json.loads(capsys.readouterr().out)
     assert learned["variant"] == variant and learned["iterations"] >= 2
     assert main(["evaluate", str(out), "--seconds", "10", "--seeds", "3", "--json"]) == 0
     ev = json.loads(capsys.readouterr().out)
-    assert ev["learned"]["seeds"] == ev["open_loop"]["seeds"] == 3
-    assert ev["open_loop"]["scale_reached"] == learned["scale_reached"]
-    assert ev["comparison"]["robots"] == 3
-    if variant == "extended" and learned["scale_reached"] > 0:
-        assert learned["channel_gain"] == learned["gain_trials"]["gain"] in (0.0, 0.5, 1.0)
+    sides = ev["controllers"]
+    assert sides["learned"]["robots"] == sides["open_loop"]["robots"] == 3
+    assert ev["settings"]["scale"] == learned["scale_reached"]
+    assert ev["comparison"]["learned"]["robots"] == 3
+    if variant == "extended":  # every trial-picked gain is one of its candidates
+        trials = TrialConfig()
+        assert set(learned["feedback_gains"]) == {"pitch", "roll", "heading"}
+        for name, value in learned["feedback_gains"].items():
+            assert value in getattr(trials, name), name
+        assert learned["trust"] in LqrConfig().trust
+        assert set(sides) == {"learned", "feedback", "fixed", "open_loop"}
 
 
 @pytest.mark.slow
@@ -51,6 +71,8 @@ def test_demo_writes_a_report(tmp_path, capsys):
     assert res["report"] == str(out / "report.html")
     for part in ("Fig. 3", "Fig. 4", "Fig. 6", "Fig. 7", "Fig. 8", "<video", "Evaluation"):
         assert part in page, part
+    assert "Protocol <b>eval</b>" in page and (out / "protocol_eval.json").is_file()
+    assert res["learned_falls"].endswith("/8") and res["open_loop_falls"].endswith("/8")
     assert (out / "before_after.mp4").stat().st_size > 10_000
     assert (out / "filmstrip.png").is_file()
 
@@ -61,11 +83,13 @@ def test_learn_and_evaluate_on_bullet(tmp_path, capsys):
     out = tmp_path / "run"
     argv = ["learn", "--out", str(out), "--json", "--set", "engine=bullet"]
     argv += ["--set", "retarget.search_config.engine=bullet"]
-    argv += [a for s in QUICK for a in ("--set", s)]
+    argv += sets([*SEARCH, *TICK, "start=0.3", "step=0.1", "stop=0.4"])
     assert main(argv) == 0
     learned = json.loads(capsys.readouterr().out)
     assert learned["iterations"] >= 2
-    assert main(["evaluate", str(out), "--seconds", "10", "--seeds", "2", "--json"]) == 0
+    assert json.loads((out / "config.json").read_text())["learn"]["engine"] == "bullet"
+    argv = ["evaluate", str(out), "--seconds", "10", "--seeds", "2", "--json"]
+    assert main([*argv, "--protocol", "bullet"]) == 0
     ev = json.loads(capsys.readouterr().out)
-    assert ev["settings"]["engine"] == "bullet"  # the engine the run learned on
-    assert (out / "evaluation.json").is_file() and ev["learned"]["seeds"] == 2
+    assert ev["settings"]["engine"] == "bullet"
+    assert (out / "protocol_bullet.json").is_file() and ev["controllers"]["learned"]["robots"] == 2

@@ -1,0 +1,96 @@
+"""The learn and evaluate commands: what they write, and what they refuse in one line
+(exit status 2) before any work."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from conftest import TICK, sets
+from imitwalk import pushes
+from imitwalk.cli import main
+from imitwalk.runs import RunDir
+
+
+@pytest.fixture
+def run(tick_run, tmp_path):
+    """A copy of the tiny per-tick run (evaluate writes into it)."""
+    out = tmp_path / "run"
+    shutil.copytree(tick_run, out)
+    return out
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err and err[-1].startswith("error: "), err
+    assert sum(line.startswith("error") for line in err) == 1 and "Traceback" not in str(err)
+    return err[-1]
+
+
+def test_evaluate_judges_every_controller_and_writes_the_protocols_file(run, capsys):
+    argv = ["evaluate", str(run), "--seconds", "3", "--seeds", "2", "--workers", "1", "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out["controllers"]) == ["learned", "feedback", "fixed", "open_loop"]
+    assert out == RunDir(run).read_json("protocol_eval.json")
+    assert out["protocol"] == {"name": "eval", "version": 1, "path": "eval"}
+    assert main([*argv, "--controllers", "learned,open_loop", "--protocol", "hard"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out["controllers"]) == ["learned", "open_loop"] and list(out["comparison"]) == [
+        "learned"
+    ]
+    assert RunDir(run).exists("protocol_hard.json")
+
+
+@pytest.mark.parametrize(
+    ("args", "expect"),
+    [
+        (["--protocol", "nosuch"], "unknown protocol 'nosuch'; valid: bullet, eval, hard"),
+        (
+            ["--controllers", "nosuch"],
+            "unknown controller 'nosuch'; valid: feedback, fixed, learned, open_loop",
+        ),
+        (
+            ["--push-recovery", "--controllers", "learned,nosuch"],
+            "unknown controller 'nosuch'; valid: feedback, fixed, learned, open_loop",
+        ),
+        (["--seeds", "0"], "--seeds 0 --seconds 30: expected >= 1 robots and > 0 s"),
+    ],
+)
+def test_evaluate_refuses_in_one_line(run, capsys, args, expect):
+    assert main(["evaluate", str(run), "--workers", "1", *args]) == 2
+    assert _one_line_error(capsys) == f"error: {expect}"
+    assert not list(run.glob("protocol_*.json")) and not RunDir(run).exists("push_recovery.json")
+
+
+def test_evaluate_push_recovery_writes_its_table(run, capsys, monkeypatch):
+    monkeypatch.setattr(pushes, "survives", lambda job: job.speed < 0.2)
+    argv = ["evaluate", str(run), "--push-recovery", "--controllers", "fixed", "--workers", "1"]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out == RunDir(run).read_json("push_recovery.json")
+    assert list(out["controllers"]) == ["fixed"]
+    least = out["controllers"]["fixed"]["min_by_direction"]
+    assert all(0.2 - out["settings"]["resolution_mps"] <= v < 0.2 for v in least.values())
+
+
+def test_learn_refuses_a_setting_out_of_range_before_any_work(tick_reference, tmp_path, capsys):
+    out = tmp_path / "run"
+    argv = ["learn", "--reference", str(tick_reference), "--out", str(out), "--set", "lqr.trust=5"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "error: lqr.trust: 5 is outside the valid range 0..2"
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["learn", "demo"])
+def test_an_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, command):
+    out = tmp_path / "taken"
+    out.write_text("not a run\n")
+    argv = [command, "--out", str(out)] + (sets(TICK) if command == "learn" else [])
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"error: {out} is a file, not a run folder; choose another --out"
+    assert out.read_text() == "not a run\n"  # untouched, and nothing retargeted or learned
