@@ -7,16 +7,21 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.channels import CHANNELS, FEATURES, channel_matrix, check_names
+from imitwalk.channels import CHANNELS, FEATURES, PHASED, channel_matrix, check_names
 from imitwalk.errors import ConfigError
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.sampled_from(sorted(CHANNELS)), min_size=1, max_size=6, unique=True))
+@given(
+    st.lists(
+        st.sampled_from(sorted(set(CHANNELS) - set(PHASED))), min_size=1, max_size=6, unique=True
+    )
+)
 def test_a_channel_moves_its_joints_by_its_value_and_nothing_else(robot, channels):
     names = robot.joint_names
-    E = channel_matrix(names, tuple(channels))  # (n, m)
-    assert E.shape == (len(names), len(channels))
+    full = channel_matrix(names, tuple(channels))  # (1, n, m): no phased channel
+    assert full.shape == (1, len(names), len(channels))
+    E = full[0]
     for c, channel in enumerate(channels):
         moved = {names[i] for i in np.flatnonzero(E[:, c])}
         assert moved == set(CHANNELS[channel])
@@ -51,4 +56,17 @@ def test_a_robot_without_a_channels_joint_is_refused_naming_its_joints():
     msg = str(err.value)
     assert "'r_ankle_pitch'" in msg and "valid: l_ankle_pitch, l_knee" in msg
     assert len(msg.splitlines()) == 1
-    np.testing.assert_array_equal(channel_matrix(joints, ("l_ankle_pitch",)), [[1.0], [0.0]])
+    np.testing.assert_array_equal(channel_matrix(joints, ("l_ankle_pitch",)), [[[1.0], [0.0]]])
+
+
+def test_a_phased_channel_needs_the_stance_schedule_and_follows_it(robot):
+    names = robot.joint_names
+    with pytest.raises(ConfigError, match="needs the stance schedule"):
+        channel_matrix(names, ("turn",))
+    stance = np.zeros((40, 2), dtype=bool)
+    stance[:20, 0] = stance[20:, 1] = True  # left foot down, then the right
+    E = channel_matrix(names, ("turn", "ankle_pitch"), stance)
+    assert E.shape == (40, len(names), 2)
+    moved = {names[i] for i in np.flatnonzero(np.any(E[:, :, 0] != 0, axis=0))}
+    assert moved == set(CHANNELS["turn"])
+    assert np.all(E[:, :, 1] == E[0, :, 1])  # an unphased channel is the same every tick

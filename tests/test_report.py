@@ -143,12 +143,6 @@ def test_figures_take_empty_data(run_dir):
         assert plots.png_bytes(fig)[:4] == b"\x89PNG"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=TypeError,
-    reason="src bug: curves.learning_curves reads the old log's prediction by level "
-    "({'tick': ...}); the faithful learner now logs the report itself, or None",
-)
 def test_a_faithful_run_has_a_report(robot, tiny_reference, tmp_path):
     ref, _ = tiny_reference
     out = tmp_path / "run"

@@ -3,6 +3,16 @@
 An implementation, and extension, of Chalodhorn, Grimes, Grochow & Rao,
 *Learning to Walk through Imitation*, IJCAI 2007, on a HOAP-2-class humanoid
 simulated in MuJoCo.
+
+The flat API loads each stage when it is first used (``import imitwalk`` does not import
+MuJoCo)::
+
+    import imitwalk as iw
+
+    robot = iw.load_robot("hoap2")
+    ref = iw.retarget(iw.load_motion(iw.default_clip()), robot).reference
+    iw.learn_tick(ref, robot, iw.TickLearnConfig(), "RUN")
+    judged = iw.judge_protocol("RUN", robot, iw.load_protocol("eval"), seeds=40)
 """
 
 from __future__ import annotations
@@ -21,9 +31,44 @@ from imitwalk.errors import (
     RunError,
 )
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
+
+#: The flat API: name -> the module that defines it (imported on first use).
+_LAZY = {
+    "load_motion": "imitwalk.mocap",
+    "default_clip": "imitwalk.mocap",
+    "Motion": "imitwalk.mocap",
+    "load_robot": "imitwalk.robots",
+    "Robot": "imitwalk.robots",
+    "retarget": "imitwalk.retarget",
+    "RetargetConfig": "imitwalk.retarget",
+    "Reference": "imitwalk.retarget",
+    "TickLearnConfig": "imitwalk.tickconfig",
+    "learn_tick": "imitwalk.ticklearn",
+    "load_laws": "imitwalk.tickstore",
+    "load_protocol": "imitwalk.protocol",
+    "judge_protocol": "imitwalk.judge",
+    "push_recovery": "imitwalk.pushes",
+    "write_report": "imitwalk.report",
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'imitwalk' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
+    *_LAZY,
     "ConfigError",
     "ImitwalkError",
     "MocapError",

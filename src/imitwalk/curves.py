@@ -17,9 +17,10 @@ from imitwalk.plots import _figure
 __all__ = ["gyro_traces", "learning_curves", "push_polar", "tick_curves", "torso_paths"]
 
 
-def _ratio(entry: dict, level: str) -> float:
-    """A model's prediction RMSE over the no-action baseline's at one iteration."""
-    pred = entry.get("prediction", {}).get(level, {})
+def _ratio(entry: dict) -> float:
+    """The gyro model's prediction RMSE over the no-action baseline's at one iteration
+    (NaN before there is a model)."""
+    pred = entry.get("prediction") or {}
     if "overall_ratio" in pred:
         return float(pred["overall_ratio"])
     return float(np.mean(pred["ratio"])) if "ratio" in pred else np.nan
@@ -38,17 +39,12 @@ def learning_curves(log: Sequence[dict]) -> Figure:
     val = lambda k: np.array([np.nan if e.get(k) is None else e[k] for e in log], float)  # noqa: E731
     ax = axes[0]
     ax.plot(it, val("cost_measured"), "o-", label="measured")
-    for key, style, level in (
-        ("cost_predicted", "s--", "tick"),
-        ("step_cost_predicted", "^:", "step"),
-    ):
-        if np.isfinite(val(key)).any():
-            ax.plot(it, val(key), style, label=f"predicted ({level} model)")
+    if np.isfinite(val("cost_predicted")).any():
+        ax.plot(it, val("cost_predicted"), "s--", label="predicted (gyro model)")
     ax.set_ylabel("cost Γ(ω)")
     ax.legend(fontsize=8)
     ax = axes[1]
-    for level in sorted({k for e in log for k in e.get("prediction", {})}):
-        ax.plot(it, [_ratio(e, level) for e in log], "o-", label=f"{level} model")
+    ax.plot(it, [_ratio(e) for e in log], "o-", label="gyro model")
     ax.axhline(1.0, color="k", ls="--", lw=0.8, label="no-action baseline")
     ax.set_ylabel("RMSE / baseline")
     ax.legend(fontsize=8)

@@ -24,8 +24,9 @@ DEMO_RETARGET = [
     "search_config.seconds=10",
     "search_config.models=2",
 ]
-DEMO_LEARN = ["start=0.6", "step=0.2", "iterations=2", "robots=2", "seconds=10",
-              "trials.robots=3", "trials.seconds=10"]  # fmt: skip
+DEMO_LEARN = ["start=0.6", "step=0.2", "iterations=2", "robots=2", "seconds=6",
+              "trials.robots=4", "trials.seconds=10", "trials.heading_robots=2",
+              "trials.heading_seconds=20"]  # fmt: skip
 
 
 def run_demo(out: Path) -> dict:

@@ -127,7 +127,8 @@ def judge_protocol(
         ``progress_ratio_min``, ``falls_by_furthest_factor`` and ``per_seed``.
     """
     metrics = RunDir(run_dir).read_json("metrics.json")
-    valid = _loaded(str(run_dir)).controllers()
+    loaded = _loaded(str(run_dir))
+    valid = loaded.controllers()
     controllers = valid if controllers is None else tuple(controllers)
     for c in controllers:
         if c not in valid:
@@ -145,11 +146,14 @@ def judge_protocol(
             scale,
             protocol.engine,
         )
-        for c in controllers
+        for c in dict.fromkeys(loaded.twin(c) for c in controllers)  # exact copies walk once
         for d in draws
     ]
     res = run_parallel(run_controller, jobs, workers)
-    by = {c: [r for r, j in zip(res, jobs, strict=True) if j.controller == c] for c in controllers}
+    by = {
+        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == loaded.twin(c)]
+        for c in controllers
+    }
     out = {
         "protocol": {"name": protocol.name, "version": protocol.version, "path": protocol.path},
         "settings": {

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import RunDir
@@ -57,6 +59,22 @@ class LoadedRun:
         names = tuple(self.laws) if self.laws is not None else ("learned",)
         return (*names, OPEN_LOOP)
 
+    def twin(self, controller: str) -> str:
+        """The first controller that is ``controller``'s exact copy (itself if none is):
+        a run whose model-based law was not kept has ``learned`` equal to ``feedback``,
+        and a judge walks such a pair once."""
+        if self.laws is None or controller == OPEN_LOOP:
+            return controller
+        mine = [law.to_arrays("") for law in self.laws[controller]]
+        for other in self.controllers():
+            theirs = [law.to_arrays("") for law in self.laws.get(other, ())]
+            if len(theirs) == len(mine) and all(
+                a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+                for a, b in zip(mine, theirs, strict=True)
+            ):
+                return other
+        return controller
+
     def policy(self, controller: str, robot, scale: float | None = None, seconds: float = 30.0):
         """A fresh controller ``controller`` (no exploration) at ``scale`` (default: the
         scale reached) for a walk of ``seconds`` [s].
@@ -83,7 +101,7 @@ def load_run(run_dir) -> LoadedRun:
     config, metrics = rd.read_json("config.json"), rd.read_json("metrics.json")
     engine = str(config.get("learn", {}).get("engine", "mujoco"))
     if config.get("learner") == "tick":
-        from imitwalk.ticklearn import load_laws
+        from imitwalk.tickstore import load_laws
 
         ref = Reference.load(rd.file("reference.npz"))
         scale = float(metrics["scale_reached"])

@@ -6,8 +6,8 @@ and ends where an uninterrupted one would:
 1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
    roll, heading → turn (steering: :data:`~imitwalk.channels.PHASED`), with each gain
    chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
-   robots of the schedule's protocol and of ``trial_protocol``. This is the baseline;
-   the learned law starts from it.
+   many short walks of training robots. This is the baseline; the learned law starts
+   from it.
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.tickmodel.PhaseModel`), turn it into gains by
@@ -15,12 +15,13 @@ and ends where an uninterrupted one would:
    a scale is passed by an iteration without exploration in which no training robot
    falls. The learned law acts on top of the trial-picked one.
 3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the top
-   scale, on the trials' robots; the fraction that ranks best is kept (0: the
+   scale, on the trials' robots; the smallest fraction that falls least is kept (0: the
    trial-picked law alone).
 
-The run's controllers are judged at the top scale (``scale_reached``): the trials chose
-the feedback there; ``scales_passed`` says how far the schedule carried the model-based
-law.
+``scale_reached`` is the top scale if the kept law walked every trial robot there without
+a fall, else the highest scale the schedule passed (the first if none): the run's
+controllers are judged there. ``scales_passed`` says how far the schedule carried the
+model-based law.
 
 Training robots come from ``train_protocol`` with seeds no evaluation uses.
 """
@@ -32,7 +33,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from imitwalk.config import from_dict, to_dict
+from imitwalk.config import to_dict
 from imitwalk.errors import RunError
 from imitwalk.feedback import Episode, FeedbackLaw
 from imitwalk.lqr import Costs, horizon_gains
@@ -45,17 +46,16 @@ from imitwalk.runs import RunDir
 from imitwalk.tickconfig import TickLearnConfig
 from imitwalk.tickmodel import PhaseModel, nominal_profile
 from imitwalk.tickrun import TickJob, TickResult, run_tick_episode
-
-__all__ = ["TRIAL_GAINS", "TickProgress", "learn_tick", "load_laws"]
-
-#: The trial-picked gains, in the order they are tried: (setting, channel, feature, the
-#: measure that decides between candidates that fall alike: the eq.-6 cost Γ for the
-#: balance gains, the mean |yaw drift| for the heading's).
-TRIAL_GAINS = (
-    ("pitch", "ankle_pitch", "gyro_y", "cost"),
-    ("roll", "ankle_roll", "gyro_x", "cost"),
-    ("heading", "turn", "heading", "abs_yaw_deg"),
+from imitwalk.tickstore import (
+    TRIAL_GAINS,
+    feedback_law,
+    load_learned,
+    save_learned,
+    stack_episodes,
+    unstack_episodes,
 )
+
+__all__ = ["TickProgress", "learn_tick"]
 
 
 @dataclass
@@ -83,15 +83,6 @@ class TickProgress:
     wall_seconds: float = 0.0
 
 
-def _feedback_law(cfg: TickLearnConfig, gains: dict) -> FeedbackLaw:
-    channels = tuple(c for _, c, _, _ in TRIAL_GAINS)
-    features = tuple(dict.fromkeys(f for _, _, f, _ in TRIAL_GAINS))
-    law = FeedbackLaw.zero(channels, features, cfg.trials.box)
-    for name, channel, feature, _ in TRIAL_GAINS:
-        law = law.with_gain(channel, feature, float(gains.get(name, 0.0)))
-    return law
-
-
 class _Learner:
     """The stages' shared context: the run folder, the robots and the budget."""
 
@@ -99,14 +90,13 @@ class _Learner:
         self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
         self.say = progress or (lambda _line: None)
         self.protocol = load_protocol(cfg.train_protocol)
-        self.trial_protocol = load_protocol(cfg.trial_protocol)
         self.scales = cfg.scales()
         self.ref_path = str(rd.file("reference.npz"))
 
-    def robots(self, n: int, first: int, seconds: float, trial: bool = False):
-        protocol = self.trial_protocol if trial else self.protocol
+    def robots(self, n: int, first: int, seconds: float):
         return [
-            protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds) for j in range(n)
+            self.protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds)
+            for j in range(n)
         ]
 
     def run(self, state: TickProgress, scale, laws, draws, seconds, explore=0.0, rng=0):
@@ -132,23 +122,12 @@ class _Learner:
         return out
 
 
-def _rank(results: list[TickResult], measure: str = "cost") -> tuple[int, float, float]:
-    """Fewest falls, then the longest walks before them, then the least ``measure``
-    (``cost``: Γ; ``abs_yaw_deg``: |yaw drift|) over the robots that did not fall."""
-    falls = sum(r.fell for r in results)
-    before = -sum(r.fall_time_s or 0.0 for r in results if r.fell)
-    up = [r for r in results if not r.fell]
-    if not up:
-        return falls, before, float("inf")
-    values = [r.cost if measure == "cost" else abs(r.yaw_drift_deg) for r in up]
-    return falls, before, float(np.mean(values))
-
-
 def _summary(results: list[TickResult]) -> dict:
+    up = [r for r in results if not r.fell]
     return {
         "falls": int(sum(r.fell for r in results)),
         "robots": len(results),
-        "cost": _rank(results)[2],
+        "cost": float(np.mean([r.cost for r in up])) if up else float("inf"),
         "walked_s": float(sum(r.seconds for r in results)),
         "distance_m": float(np.mean([r.distance_m for r in results])),
         "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
@@ -157,35 +136,36 @@ def _summary(results: list[TickResult]) -> dict:
 
 @dataclass(frozen=True)
 class Trial:
-    """One candidate's trials at the top scale: on ``walking`` robots (the schedule's
-    protocol) and on ``hard`` ones (``trial_protocol``)."""
+    """One candidate's walks at the top scale, on the training robots."""
 
-    walking: list
-    hard: list
+    results: list
 
-    def rank(self, measure: str) -> tuple:
-        """Fewest falls where robots walk, then fewest falls (and the longest walks before
-        them) on the hard robots, then the least ``measure`` where robots walk for
-        ``abs_yaw_deg`` (the heading), else on the hard robots (the balance)."""
-        w, h = _rank(self.walking, measure), _rank(self.hard, measure)
-        return (w[0], h[0], h[1], w[2] if measure == "abs_yaw_deg" else h[2])
+    def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
+        """The order candidates are kept in (least first): the fewest falls; then, where
+        the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
+        beyond that limit; then the smallest ``|value|``. A lower
+        Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
+        the gain where robots start to fall (docs/RESULTS.md)."""
+        s = self.summary()
+        drift = 0.0 if yaw_limit_deg is None else max(0.0, s["abs_yaw_deg"] - yaw_limit_deg)
+        return (s["falls"], drift, abs(value))
 
     def summary(self) -> dict:
-        return {"walking": _summary(self.walking), "hard": _summary(self.hard)}
+        return _summary(self.results)
 
 
-def _trial(lr: _Learner, state: TickProgress, key: str, laws) -> Trial:
-    """The trials of ``laws`` at the top scale, run once per key (kept in the checkpoint,
-    so that a resumed run neither repeats nor re-counts them)."""
+def _trial(lr: _Learner, state: TickProgress, key: str, laws, heading: bool = False) -> Trial:
+    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), run
+    once per key (kept in the checkpoint, so that a resumed run neither repeats nor
+    re-counts them)."""
+    t = lr.cfg.trials
+    n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
+    key = f"{key}@{n}x{seconds:g}s"
     if key not in state.tried:
-        cfg, top = lr.cfg, lr.scales[-1]
-        n, first, seconds = cfg.trials.robots, TRIAL_SEED_BASE + 1, cfg.trials.seconds
-        draws = lr.robots(n, first, seconds) + lr.robots(n, first, seconds, trial=True)
-        res = lr.run(state, top, laws, draws, seconds)
+        top = lr.scales[-1]
+        res = lr.run(state, top, laws, lr.robots(n, TRIAL_SEED_BASE + 1, seconds), seconds)
         state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
-    res = [TickResult(**r) for r in state.tried[key]]
-    half = len(res) // 2
-    return Trial(res[:half], res[half:])
+    return Trial([TickResult(**r) for r in state.tried[key]])
 
 
 def _gains_key(gains: dict, extra: str = "") -> str:
@@ -193,14 +173,11 @@ def _gains_key(gains: dict, extra: str = "") -> str:
 
 
 def _say_table(lr: _Learner, head: str, table) -> None:
-    """One progress line: per candidate, falls walking + hard, hard seconds walked, |yaw|."""
+    """One progress line: per candidate, its falls and mean |yaw|."""
     cells = []
     for v, t in table:
-        w, h = t.summary()["walking"], t.summary()["hard"]
-        cells.append(
-            f"[{v:g}: {w['falls']}+{h['falls']} fell, {h['walked_s']:.0f} s, "
-            f"{w['abs_yaw_deg']:.1f} deg]"
-        )
+        s = t.summary()
+        cells.append(f"[{v:g}: {s['falls']}/{s['robots']} fell, {s['abs_yaw_deg']:.1f} deg]")
     lr.say(f"{head} {' '.join(cells)}")
 
 
@@ -208,13 +185,14 @@ def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
     """Stage 1: one gain at a time, each from its candidates, at the top scale."""
     cfg = lr.cfg
     while state.trial < len(TRIAL_GAINS):
-        name, channel, feature, measure = TRIAL_GAINS[state.trial]
+        name, channel, feature, steers = TRIAL_GAINS[state.trial]
+        limit = cfg.trials.yaw_limit_deg if steers else None
         table = []
         for value in getattr(cfg.trials, name):
             gains = {**state.gains, name: float(value)}
-            laws = [_feedback_law(cfg, gains)]
-            table.append((float(value), _trial(lr, state, _gains_key(gains), laws)))
-        best = min(table, key=lambda row: (row[1].rank(measure), abs(row[0])))[0]
+            laws = [feedback_law(cfg, gains)]
+            table.append((float(value), _trial(lr, state, _gains_key(gains), laws, steers)))
+        best = min(table, key=lambda row: row[1].rank(row[0], limit))[0]
         state.gains[name] = best
         log.append(
             {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
@@ -234,15 +212,19 @@ def _learned_law(lr: _Learner, episodes: list[Episode]):
     shell = FeedbackLaw.zero(c.channels, c.features, c.box, n_ticks=n, memory=True)
     shell = replace(shell, nominal=nominal_profile(episodes, c.features, n))
     model = PhaseModel(n_phases=n, width=c.width, ridge=c.ridge).fit(episodes, shell)
-    costs = Costs(tuple(c.state_cost), c.action_cost, c.change_cost, c.horizon)
+    costs = Costs(c.costs(), c.action_cost, c.change_cost, c.horizon)
     return replace(shell, gains=horizon_gains(model, costs)), model
 
 
 def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
     """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
     cfg = lr.cfg
-    base = _feedback_law(cfg, state.gains)
-    learned, model = _load_learned(lr.rd), None
+    base = feedback_law(cfg, state.gains)
+    learned, model = load_learned(lr.rd), None
+    if data and state.scale_index < len(lr.scales):  # resumed: the model of the last iteration
+        last = log[-1]["scale"] if log and log[-1].get("stage") == "schedule" else None
+        if last is not None:
+            learned, model = _learned_law(lr, [e for s, e in data if abs(s - last) < 1e-9])
     while state.scale_index < len(lr.scales):
         scale = lr.scales[state.scale_index]
         explore = cfg.lqr.explore if state.iteration == 0 else 0.0
@@ -276,9 +258,9 @@ def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> Feedb
             break
         else:
             state.iteration += 1
-        _save_learned(lr.rd, learned)
+        save_learned(lr.rd, learned)
         _checkpoint(lr, state, log, data)
-    _save_learned(lr.rd, learned)
+    save_learned(lr.rd, learned)
     state.stage = "trust"
     return learned
 
@@ -290,13 +272,13 @@ def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | 
     if learned is None:
         state.trust, state.stage = 0.0, "done"
         return
-    base = _feedback_law(cfg, state.gains)
+    base = feedback_law(cfg, state.gains)
     table = []
     for frac in cfg.lqr.trust:
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
         key = _gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
         table.append((float(frac), _trial(lr, state, key, laws)))
-    best = min(table, key=lambda row: (row[1].rank("cost"), row[0]))[0]
+    best = min(table, key=lambda row: row[1].rank(row[0]))[0]
     state.trust, state.stage = best, "done"
     log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
                 "table": [{"fraction": f, **t.summary()} for f, t in table]})  # fmt: skip
@@ -305,59 +287,9 @@ def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | 
 
 def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None = None) -> None:
     if data is not None:
-        lr.rd.write_arrays("data.npz", _stack(data))
+        lr.rd.write_arrays("data.npz", stack_episodes(data))
     lr.rd.write_log(log)
     lr.rd.write_json("checkpoint.json", asdict(state))
-
-
-def _stack(data: list[tuple[float, Episode]]) -> dict[str, np.ndarray]:
-    if not data:
-        return {}
-    return {
-        "scale": np.array([s for s, _ in data]),
-        "length": np.array([len(e.phase) for _, e in data]),
-        "phase": np.concatenate([e.phase for _, e in data]),
-        "features": np.vstack([e.features for _, e in data]),
-        "actions": np.vstack([e.actions for _, e in data]),
-    }
-
-
-def _unstack(arrays: dict) -> list[tuple[float, Episode]]:
-    if "length" not in arrays:
-        return []
-    cut = np.cumsum(arrays["length"])[:-1]
-    parts = [np.split(arrays[k], cut) for k in ("phase", "features", "actions")]
-    return [(float(s), Episode(*p)) for s, *p in zip(arrays["scale"], *parts, strict=True)]
-
-
-def _save_learned(rd: RunDir, law: FeedbackLaw | None) -> None:
-    if law is not None:
-        rd.write_arrays("learned.npz", law.to_arrays(""))
-
-
-def _load_learned(rd: RunDir) -> FeedbackLaw | None:
-    if not rd.exists("learned.npz"):
-        return None
-    return FeedbackLaw.from_arrays(rd.read_arrays("learned.npz"), "")
-
-
-def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
-    """The controllers a finished per-tick run can build, by name: ``feedback`` (the
-    trial-picked law), ``learned`` (with the kept fraction of the model-based law on top)
-    and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""
-    rd = RunDir(run_dir)
-    metrics = rd.read_json("metrics.json")
-    cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
-    base = _feedback_law(cfg, metrics["feedback_gains"])
-    fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
-        "ankle_pitch", "gyro_y", 0.05
-    )
-    learned = (base,)
-    frac = float(metrics.get("trust") or 0.0)
-    law = _load_learned(rd)
-    if frac > 0 and law is not None:
-        learned = (base, replace(law, gains=law.gains * frac))
-    return {"learned": learned, "feedback": (base,), "fixed": (fixed,)}
 
 
 def learn_tick(
@@ -378,7 +310,7 @@ def learn_tick(
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
         state = TickProgress(**rd.read_json("checkpoint.json"))
         log = rd.read_log()
-        data = _unstack(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
+        data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
     else:
         if rd.exists("checkpoint.json"):
             raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
@@ -390,16 +322,21 @@ def learn_tick(
     if state.stage == "trials":
         _trials(lr, state, log)
         _checkpoint(lr, state, log, data)
-    learned = _load_learned(rd)
+    learned = load_learned(rd)
     if state.stage == "schedule":
         learned = _schedule(lr, state, log, data)
         _checkpoint(lr, state, log, data)
     if state.stage == "trust":
         _trust(lr, state, log, learned)
         _checkpoint(lr, state, log, data)
+    kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
+    row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
+    top_falls = int(row["falls"])
+    reached = lr.scales[-1] if top_falls == 0 else max(state.passed, default=lr.scales[0])
     summary = {
         "learner": "tick",
-        "scale_reached": lr.scales[-1],
+        "scale_reached": reached,
+        "trial_falls_at_top": top_falls,
         "scales_passed": state.passed,
         "feedback_gains": state.gains,
         "trust": state.trust,

@@ -1,0 +1,52 @@
+"""How the trials rank candidates (pure: made-up walk results)."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from imitwalk.ticklearn import Trial
+from imitwalk.tickrun import TickResult
+
+
+def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> Trial:
+    return Trial(
+        [
+            TickResult(
+                j,
+                j < falls,
+                3.0 if j < falls else None,
+                3.0 if j < falls else 10.0,
+                1.0,
+                yaw,
+                float("inf") if j < falls else cost,
+            )
+            for j in range(robots)
+        ]
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 8), st.floats(0.0, 1.0), st.floats(0.1, 3.0)),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_the_fewest_falls_win_then_the_smallest_gain_whatever_the_cost(rows):
+    table = [(round(0.05 * i, 2), _walks(f, cost=c)) for i, (f, _, c) in enumerate(rows)]
+    best = min(table, key=lambda row: row[1].rank(row[0]))
+    fewest = min(t.summary()["falls"] for _, t in table)
+    assert best[1].summary()["falls"] == fewest
+    assert best[0] == min(v for v, t in table if t.summary()["falls"] == fewest)
+
+
+def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit():
+    limit = 10.0  # deg, over the heading's whole walks
+    table = [(0.0, _walks(0, yaw=12.0)), (-0.25, _walks(0, yaw=8.0)), (-0.5, _walks(0, yaw=3.0))]
+    pick = lambda t: min(t, key=lambda row: row[1].rank(row[0], limit))[0]  # noqa: E731
+    assert pick(table) == -0.25  # the least steering within the limit, not the least drift
+    assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 9.0), (-0.5, 1.0))]) == 0.0
+    assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 19.0), (-0.5, 15.0))]) == -0.5
+    assert pick([(0.0, _walks(0, yaw=19.0)), (-0.5, _walks(1, yaw=1.0))]) == 0.0  # falls first
