@@ -55,6 +55,14 @@ def strip_log(log: list[dict]) -> list[dict]:
     return [{k: v for k, v in e.items() if k != "wall_seconds"} for e in log]
 
 
+def _missing(why: str) -> None:
+    """Skip a test whose input is absent, or fail it where it is required
+    (``IMITWALK_REQUIRE_INPUTS=1``, as ``.ci/run`` sets: CI must not pass by skipping)."""
+    if os.environ.get("IMITWALK_REQUIRE_INPUTS") == "1":
+        pytest.fail(why + "; IMITWALK_REQUIRE_INPUTS=1 requires it")
+    pytest.skip(why)
+
+
 @pytest.fixture(scope="session")
 def shared_mocap() -> Path:
     """Folder of the shared real mocap fixtures: ``$IMITWALK_SHARED_MOCAP``, else
@@ -62,7 +70,7 @@ def shared_mocap() -> Path:
     env = os.environ.get("IMITWALK_SHARED_MOCAP")
     path = Path(env) if env else Path(__file__).resolve().parents[1].parent / "shared" / "mocap"
     if not path.is_dir():
-        pytest.skip(f"shared mocap folder not found: {path} (set IMITWALK_SHARED_MOCAP)")
+        _missing(f"shared mocap folder not found: {path} (set IMITWALK_SHARED_MOCAP)")
     return path
 
 
@@ -73,7 +81,7 @@ def shared_robots() -> Path:
     env = os.environ.get("IMITWALK_SHARED_ROBOTS")
     path = Path(env) if env else Path(__file__).resolve().parents[1].parent / "shared" / "robots"
     if not path.is_dir():
-        pytest.skip(f"shared robots folder not found: {path} (set IMITWALK_SHARED_ROBOTS)")
+        _missing(f"shared robots folder not found: {path} (set IMITWALK_SHARED_ROBOTS)")
     return path
 
 

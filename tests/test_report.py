@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 
-from conftest import TINY
+from conftest import TINY, _missing
 from imitwalk import pushes
 from imitwalk.cli import main
 from imitwalk.config import apply_overrides
@@ -161,7 +161,7 @@ def _chromium() -> str | None:
 def browser(tmp_path_factory):
     exe = _chromium()
     if exe is None:
-        pytest.skip("no Chromium binary found (apt-get install chromium, or set IMITWALK_CHROMIUM)")
+        _missing("no Chromium binary found (apt-get install chromium, or set IMITWALK_CHROMIUM)")
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:

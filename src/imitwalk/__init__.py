@@ -33,8 +33,9 @@ from imitwalk.errors import (
 
 __version__ = "0.2.0"
 
-#: The flat API: name -> the module that defines it (imported on first use).
-_LAZY = {
+#: The flat API: name -> the module that defines it, or (module, its name there); each is
+#: imported on first use.
+_LAZY: dict[str, str | tuple[str, str]] = {
     "load_motion": "imitwalk.mocap",
     "default_clip": "imitwalk.mocap",
     "Motion": "imitwalk.mocap",
@@ -45,6 +46,13 @@ _LAZY = {
     "Reference": "imitwalk.retarget",
     "TickLearnConfig": "imitwalk.tickconfig",
     "learn_tick": "imitwalk.ticklearn",
+    "learn": ("imitwalk.ticklearn", "learn_tick"),
+    "load_run": "imitwalk.replay",
+    "evaluate_run": ("imitwalk.judge", "judge_protocol"),
+    "Plant": "imitwalk.sim",
+    "SimOptions": "imitwalk.simtypes",
+    "make_plant": "imitwalk.sim",
+    "run": "imitwalk.sim",
     "load_laws": "imitwalk.tickstore",
     "load_protocol": "imitwalk.protocol",
     "judge_protocol": "imitwalk.judge",
@@ -57,7 +65,8 @@ def __getattr__(name: str):
     if name in _LAZY:
         import importlib
 
-        value = getattr(importlib.import_module(_LAZY[name]), name)
+        module, attr = _LAZY[name] if isinstance(_LAZY[name], tuple) else (_LAZY[name], name)
+        value = getattr(importlib.import_module(module), attr)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'imitwalk' has no attribute {name!r}")

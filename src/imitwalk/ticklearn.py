@@ -31,8 +31,6 @@ from __future__ import annotations
 import time
 from dataclasses import asdict, dataclass, field, replace
 
-import numpy as np
-
 from imitwalk.config import to_dict
 from imitwalk.errors import RunError
 from imitwalk.feedback import Episode, FeedbackLaw
@@ -45,7 +43,7 @@ from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.tickconfig import TickLearnConfig
 from imitwalk.tickmodel import PhaseModel, nominal_profile
-from imitwalk.tickrun import TickJob, TickResult, run_tick_episode
+from imitwalk.tickrun import TickJob, TickResult, Trial, run_tick_episode, summarize
 from imitwalk.tickstore import (
     TRIAL_GAINS,
     feedback_law,
@@ -120,38 +118,6 @@ class _Learner:
         state.sim_seconds += sum(r.seconds for r in out)
         state.wall_seconds += time.perf_counter() - t0
         return out
-
-
-def _summary(results: list[TickResult]) -> dict:
-    up = [r for r in results if not r.fell]
-    return {
-        "falls": int(sum(r.fell for r in results)),
-        "robots": len(results),
-        "cost": float(np.mean([r.cost for r in up])) if up else float("inf"),
-        "walked_s": float(sum(r.seconds for r in results)),
-        "distance_m": float(np.mean([r.distance_m for r in results])),
-        "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
-    }
-
-
-@dataclass(frozen=True)
-class Trial:
-    """One candidate's walks at the top scale, on the training robots."""
-
-    results: list
-
-    def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
-        """The order candidates are kept in (least first): the fewest falls; then, where
-        the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
-        beyond that limit; then the smallest ``|value|``. A lower
-        Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
-        the gain where robots start to fall (docs/RESULTS.md)."""
-        s = self.summary()
-        drift = 0.0 if yaw_limit_deg is None else max(0.0, s["abs_yaw_deg"] - yaw_limit_deg)
-        return (s["falls"], drift, abs(value))
-
-    def summary(self) -> dict:
-        return _summary(self.results)
 
 
 def _trial(lr: _Learner, state: TickProgress, key: str, laws, heading: bool = False) -> Trial:
@@ -244,7 +210,7 @@ def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> Feedb
         learned, model = _learned_law(lr, near)
         fell = sum(r.fell for r in res)
         entry = {"stage": "schedule", "scale": scale, "iteration": state.iteration,
-                 "explore": explore, **_summary(res), "held_out": held}  # fmt: skip
+                 "explore": explore, **summarize(res), "held_out": held}  # fmt: skip
         log.append(entry)
         ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
         lr.say(

@@ -14,7 +14,7 @@ from imitwalk.feedback import Episode, FeedbackLaw, TickPolicy
 from imitwalk.robots import Robot
 from imitwalk.simtypes import SimOptions
 
-__all__ = ["TickJob", "TickResult", "run_tick_episode"]
+__all__ = ["TickJob", "TickResult", "Trial", "run_tick_episode", "summarize"]
 
 
 @dataclass(frozen=True)
@@ -108,3 +108,37 @@ def run_tick_episode(job: TickJob) -> TickResult:
         cost=cost if not m.fell else float("inf"),
         episode=policy.episode() if job.record else None,
     )
+
+
+def summarize(results: list[TickResult]) -> dict:
+    """Falls, robots, mean Γ of the robots that stayed up [rad²/s²], seconds walked [s],
+    mean forward distance [m] and mean |yaw| [deg] of some walks."""
+    up = [r for r in results if not r.fell]
+    return {
+        "falls": int(sum(r.fell for r in results)),
+        "robots": len(results),
+        "cost": float(np.mean([r.cost for r in up])) if up else float("inf"),
+        "walked_s": float(sum(r.seconds for r in results)),
+        "distance_m": float(np.mean([r.distance_m for r in results])),
+        "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
+    }
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One candidate's walks at the top scale, on the training robots."""
+
+    results: list
+
+    def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
+        """The order candidates are kept in (least first): the fewest falls; then, where
+        the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
+        beyond that limit; then the smallest ``|value|``. A lower
+        Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
+        the gain where robots start to fall (docs/RESULTS.md)."""
+        s = self.summary()
+        drift = 0.0 if yaw_limit_deg is None else max(0.0, s["abs_yaw_deg"] - yaw_limit_deg)
+        return (s["falls"], drift, abs(value))
+
+    def summary(self) -> dict:
+        return summarize(self.results)
