@@ -23,9 +23,9 @@ os.environ.setdefault("IMITWALK_WORKERS", "1")
 import mujoco
 import numpy as np
 
-from imitwalk.replay import load_run
+from imitwalk.judge.replay import load_run
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, run
+from imitwalk.sim.mujoco import MujocoPlant, run
 
 
 def bare(robot, steps: int) -> float:

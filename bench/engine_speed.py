@@ -16,7 +16,7 @@ import numpy as np
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.robots import load_robot
-from imitwalk.sim import make_plant, playback
+from imitwalk.sim.mujoco import make_plant, playback
 
 
 def main() -> None:

@@ -18,12 +18,12 @@ import json
 
 import numpy as np
 
-from imitwalk.feedback import FeedbackLaw
+from imitwalk.balance.feedback import FeedbackLaw
+from imitwalk.balance.tickrun import TickJob, run_tick_episode
+from imitwalk.judge.protocol import load_protocol
+from imitwalk.judge.replay import load_run
 from imitwalk.parallel import run_parallel
-from imitwalk.protocol import load_protocol
-from imitwalk.replay import load_run
 from imitwalk.robots import load_robot
-from imitwalk.tickrun import TickJob, run_tick_episode
 
 GAINS = (-0.3, -0.15, 0.15, 0.3)
 CHANNELS = ("l_hip_roll", "r_hip_roll", "l_ankle_roll", "r_ankle_roll",

@@ -20,10 +20,10 @@ import time
 import numpy as np
 import sklearn
 
-from imitwalk.controller import ActionSelector
-from imitwalk.embedding import GaitEmbedding
-from imitwalk.predictor import SensoryMotorModel
-from imitwalk.subspace import PostureSubspace
+from imitwalk.paper.controller import ActionSelector
+from imitwalk.paper.embedding import GaitEmbedding
+from imitwalk.paper.predictor import SensoryMotorModel
+from imitwalk.paper.subspace import PostureSubspace
 
 TWO_PI = 2.0 * np.pi
 

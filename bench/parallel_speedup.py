@@ -16,11 +16,11 @@ import numpy as np
 from mujoco import rollout
 
 from imitwalk.mocap import default_clip, load_motion
-from imitwalk.perturb import perturbed
-from imitwalk.playback import play_reference
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant
+from imitwalk.sim.mujoco import MujocoPlant
+from imitwalk.sim.perturb import perturbed
+from imitwalk.sim.playback import play_reference
 
 
 def _models(robot, n: int):

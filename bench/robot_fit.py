@@ -24,7 +24,7 @@ from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import extract_template
 from imitwalk.retarget.ik import leg_geometry
 from imitwalk.robots import load_robot
-from imitwalk.sim import make_plant, run
+from imitwalk.sim.mujoco import make_plant, run
 
 
 def fit(name: str, period: float, seconds: float) -> dict:

@@ -21,11 +21,11 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import cross_val_score
 
-from imitwalk.perturb import perturbed
-from imitwalk.playback import play_reference
 from imitwalk.retarget import Reference
 from imitwalk.robots import load_robot
-from imitwalk.simtypes import jitter_draws
+from imitwalk.sim.perturb import perturbed
+from imitwalk.sim.playback import play_reference
+from imitwalk.sim.types import jitter_draws
 
 
 def main() -> None:

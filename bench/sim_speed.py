@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, SimOptions
+from imitwalk.sim.mujoco import MujocoPlant, SimOptions
 
 
 def bare(robot, steps: int) -> float:

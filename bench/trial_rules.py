@@ -19,13 +19,13 @@ import json
 
 import numpy as np
 
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.tickrun import TickJob, run_tick_episode
+from imitwalk.balance.tickstore import feedback_law
+from imitwalk.judge.protocol import load_protocol
 from imitwalk.parallel import run_parallel
-from imitwalk.protocol import load_protocol
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import load_robot
-from imitwalk.tickconfig import TickLearnConfig
-from imitwalk.tickrun import TickJob, run_tick_episode
-from imitwalk.tickstore import feedback_law
 
 #: (pitch, roll, heading) gains: the coordinate search's path and its neighbours.
 LAWS = ((0, 0, 0), (0.05, 0, 0), (0.1, 0, 0), (0.2, 0, 0), (0.05, 0.05, 0), (0.1, 0.05, 0),

@@ -22,7 +22,7 @@ TINY = [
     "workers=1",
 ]
 
-#: Settings of a tiny per-tick learning run (:mod:`imitwalk.ticklearn`): scales 0.8 and 1,
+#: Settings of a tiny per-tick learning run (:mod:`imitwalk.balance.ticklearn`): scales 0.8 and 1,
 #: two training robots x 6 s, two candidates per trial-picked gain on two robots x 6 s.
 TICK = [
     "start=0.8",
@@ -111,7 +111,7 @@ def tiny_reference(robot, tmp_path_factory):
 def tick_reference(tmp_path_factory) -> Path:
     """The default clip retargeted without the parameter search (every grid scale), as
     ``imitwalk retarget --no-search`` writes it: the reference of the per-tick tests."""
-    from imitwalk.cli import main
+    from imitwalk.cli.main import main
 
     path = tmp_path_factory.mktemp("tickref") / "ref.npz"
     assert main(["retarget", "--no-search", "--out", str(path)]) == 0
@@ -122,7 +122,7 @@ def tick_reference(tmp_path_factory) -> Path:
 def tick_run(tick_reference, tmp_path_factory) -> Path:
     """A finished tiny per-tick run (:data:`TICK`) learned through the CLI. Shared: a test
     that writes into a run copies it first."""
-    from imitwalk.cli import main
+    from imitwalk.cli.main import main
 
     out = tmp_path_factory.mktemp("tickrun") / "run"
     argv = ["learn", "--reference", str(tick_reference), "--out", str(out), *sets(TICK)]

@@ -11,17 +11,17 @@ import pybullet as pb
 import pytest
 from tests.test_other_robot import _other_robot
 
-from imitwalk.bullet import BulletPlant
-from imitwalk.cli import main
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.cli.main import main
 from imitwalk.errors import ConfigError, RobotError
-from imitwalk.learnconfig import LearnConfig
-from imitwalk.perturb import perturbed
+from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.retarget.search import SearchConfig
 from imitwalk.robots import BUILTIN, load_robot
 from imitwalk.robots.urdf import to_urdf, urdf_file
-from imitwalk.sim import MujocoPlant, make_plant, playback, run
-from imitwalk.simtypes import jitter_draws
-from imitwalk.tickconfig import TickLearnConfig
+from imitwalk.sim.bullet import BulletPlant
+from imitwalk.sim.mujoco import MujocoPlant, make_plant, playback, run
+from imitwalk.sim.perturb import perturbed
+from imitwalk.sim.types import jitter_draws
 
 
 def test_urdf_carries_masses_and_frames(robot):

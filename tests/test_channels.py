@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.channels import CHANNELS, FEATURES, PHASED, channel_matrix, check_names
+from imitwalk.balance.channels import CHANNELS, FEATURES, PHASED, channel_matrix, check_names
 from imitwalk.errors import ConfigError
 
 

@@ -9,8 +9,8 @@ import shutil
 import pytest
 
 from conftest import TICK, sets
-from imitwalk import pushes
-from imitwalk.cli import main
+from imitwalk.cli.main import main
+from imitwalk.judge import pushes
 from imitwalk.runs import RunDir
 
 

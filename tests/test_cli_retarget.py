@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.mocap.vicon import read_c3d
 from test_mocap_c3d import C3D, PIG_MARKERS, _cols, write_c3d
 

@@ -8,9 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import ConfigError
-from imitwalk.metrics import walk_metrics
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import GaitCommand, GaitParams, RetargetConfig, extract_template, retarget
 from imitwalk.retarget.command import advance
@@ -18,6 +17,7 @@ from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import plan_walk
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.walkable import build_walkable
+from imitwalk.sim.metrics import walk_metrics
 
 
 @pytest.fixture(scope="module")
@@ -185,7 +185,7 @@ def test_metrics_measure_a_turn_against_its_command():
 
 
 def test_a_turning_reference_turns_on_the_robot(robot, turning):
-    from imitwalk.playback import play_reference
+    from imitwalk.sim.playback import play_reference
 
     runs = play_reference(turning, robot, 0.5, 10.0, seeds=[0, 1], workers=1)
     for r in runs:
@@ -200,7 +200,7 @@ def test_a_slope_reference_is_played_on_its_slope(robot, template):
     cmd = GaitCommand(slope_deg=3.0)
     ref = build_walkable(template, robot, GaitParams(), [0.5], 0.01, command=cmd).reference
     assert ref.sim_options().slope_deg == 3.0
-    from imitwalk.simtypes import SimOptions
+    from imitwalk.sim.types import SimOptions
 
     assert ref.sim_options(SimOptions(slope_deg=-3.0)).slope_deg == 0.0  # added to a cell's
 
@@ -242,9 +242,9 @@ def test_the_command_in_words_and_on_the_ground(turning):
 
 
 def test_the_learner_sees_heading_beyond_the_commanded_turn(robot, turning):
-    from imitwalk.channels import FEATURES
-    from imitwalk.feedback import FeedbackLaw, TickPolicy
-    from imitwalk.simtypes import Observation
+    from imitwalk.balance.channels import FEATURES
+    from imitwalk.balance.feedback import FeedbackLaw, TickPolicy
+    from imitwalk.sim.types import Observation
 
     law = FeedbackLaw.zero(("hip_yaw",), ("heading",), 0.1)
     policy = TickPolicy(turning, 1.0, (law,), robot.joint_names, 30.0)
@@ -273,11 +273,11 @@ def test_the_learner_sees_heading_beyond_the_commanded_turn(robot, turning):
 def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     """The whole loop on a turning reference: learned, evaluated against its own path."""
     from conftest import TICK
+    from imitwalk.balance.tickconfig import TickLearnConfig
+    from imitwalk.balance.ticklearn import learn_tick
     from imitwalk.config import apply_overrides
-    from imitwalk.judge import JudgeJob, run_controller
-    from imitwalk.protocol import load_protocol
-    from imitwalk.tickconfig import TickLearnConfig
-    from imitwalk.ticklearn import learn_tick
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.judge.verdict import JudgeJob, run_controller
 
     cmd = GaitCommand(turn_deg=12.0)
     ref = build_walkable(template, robot, GaitParams(), [0.3, 0.4], 0.01, command=cmd).reference

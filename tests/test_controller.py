@@ -7,11 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.controller import ActionSelector, Decision, SearchProblem, stability_cost
-from imitwalk.embedding import GaitEmbedding
 from imitwalk.errors import ConfigError
-from imitwalk.predictor import SensoryMotorModel
-from imitwalk.subspace import PostureSubspace
+from imitwalk.paper.controller import ActionSelector, Decision, SearchProblem, stability_cost
+from imitwalk.paper.embedding import GaitEmbedding
+from imitwalk.paper.predictor import SensoryMotorModel
+from imitwalk.paper.subspace import PostureSubspace
 
 TWO_PI = 2.0 * np.pi
 _CACHE: dict = {}

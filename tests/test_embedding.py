@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.embedding import GaitEmbedding, rotation_axis
 from imitwalk.errors import ConfigError
+from imitwalk.paper.embedding import GaitEmbedding, rotation_axis
 
 TWO_PI = 2.0 * np.pi
 

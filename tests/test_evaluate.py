@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.evaluate import compare_falls, wilson
+from imitwalk.paper.evaluate import compare_falls, wilson
 
 
 @settings(max_examples=60, deadline=None)

@@ -10,12 +10,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.channels import CHANNELS, FEATURES
+from imitwalk.balance.channels import CHANNELS, FEATURES
+from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
 from imitwalk.errors import ConfigError
-from imitwalk.feedback import Episode, FeedbackLaw, TickPolicy
 from imitwalk.runs import RunDir
-from imitwalk.sim import MujocoPlant, playback, run
-from imitwalk.simtypes import Observation
+from imitwalk.sim.mujoco import MujocoPlant, playback, run
+from imitwalk.sim.types import Observation
 
 #: The walk the closed-loop checks play: scale 0.4 of the tiny reference, 3 s.
 SCALE, SECONDS = 0.4, 3.0

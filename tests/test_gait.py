@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from imitwalk.gait import GaitConfig, GaitModel
+from imitwalk.paper.gait import GaitConfig, GaitModel
 
 
 @pytest.mark.parametrize("phase_source", ["time", "angle"])

@@ -13,7 +13,7 @@ import shutil
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.robots import load_robot
 from imitwalk.robots.servos import KP_PER_MGL
 from imitwalk.robots.spec import LEG_ROLES
@@ -158,7 +158,7 @@ def test_bad_robots_are_refused_in_one_line(shared_robots, tmp_path, capsys, dra
 
 
 def test_imported_robots_stand_on_bullet(drafted, capsys):
-    from imitwalk.sim import make_plant, run
+    from imitwalk.sim.mujoco import make_plant, run
 
     for name in ("op3", "g1"):
         path, _ = _import(drafted, name, capsys)
@@ -172,7 +172,7 @@ def test_op3_reference_adapts_to_its_legs(drafted, capsys):
     from imitwalk.retarget import RetargetConfig, retarget
     from imitwalk.retarget.ik import leg_geometry
     from imitwalk.retarget.search import bounds
-    from imitwalk.sim import MujocoPlant, playback
+    from imitwalk.sim.mujoco import MujocoPlant, playback
 
     path, _ = _import(drafted, "op3", capsys)
     r = load_robot(path)
@@ -215,7 +215,7 @@ def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     """evaluate and report load the robot a run's reference records (a file), not its name."""
     from dataclasses import replace
 
-    from imitwalk.commands import _run_robot
+    from imitwalk.cli.commands import _run_robot
     from imitwalk.runs import RunDir
 
     ref, _ = tiny_reference  # shared: a copy with other settings

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import RobotError
 from imitwalk.robots import BUILTIN, load_robot
 from imitwalk.robots.jointmap import parse_joint_map

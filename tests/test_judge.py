@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from imitwalk.errors import ConfigError
-from imitwalk.evaluate import compare_falls
-from imitwalk.judge import judge_protocol
-from imitwalk.protocol import load_protocol
+from imitwalk.judge.protocol import load_protocol
+from imitwalk.judge.verdict import judge_protocol
+from imitwalk.paper.evaluate import compare_falls
 
 #: Robots and seconds of the judgement (the hard protocol, where robots fall).
 SEEDS, SECONDS = 3, 6.0
@@ -67,7 +67,7 @@ def test_a_subset_of_controllers_at_another_scale(tick_run, robot):
 
 
 def test_the_breakdown_counts_each_perturbed_robots_fall_once():
-    from imitwalk.judge import _side
+    from imitwalk.judge.verdict import _side
 
     def row(seed, fell, furthest):
         return {"seed": seed, "fell": fell, "fall_time_s": 1.0 if fell else None,

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from conftest import TINY, sets, strip_log, strip_wall
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
-from imitwalk.learnconfig import preset
-from imitwalk.learner import learn
+from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learner import learn
 from imitwalk.runs import RunDir
 
 
@@ -54,7 +54,7 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
 
 
 def test_training_robot_draws_never_overlap_or_meet_an_evaluation_robot():
-    from imitwalk.perturb import TRAIN_SEED_BASE, train_seeds
+    from imitwalk.sim.perturb import TRAIN_SEED_BASE, train_seeds
 
     draws = [train_seeds(6, d) for d in range(50)]
     assert draws[0] == (0, 1001, 1002, 1003, 1004, 1005)
@@ -167,10 +167,10 @@ def test_a_short_faithful_run_lowers_the_measured_gyro_cost(tmp_path, robot, tin
     started from the standing keyframe and this comparison from the keyframe too; with
     the same start everywhere it does not: a known failure, kept strict so that a learner
     that does lower the cost is noticed."""
-    from imitwalk.controller import stability_cost
-    from imitwalk.evaluate import load_gait
-    from imitwalk.models import build_policy
-    from imitwalk.sim import MujocoPlant, run
+    from imitwalk.paper.controller import stability_cost
+    from imitwalk.paper.evaluate import load_gait
+    from imitwalk.paper.models import build_policy
+    from imitwalk.sim.mujoco import MujocoPlant, run
 
     ref, _ = tiny_reference
     cfg = apply_overrides(

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy.linalg import solve_discrete_are
 
+from imitwalk.balance.lqr import Costs, horizon_gains, state_space
+from imitwalk.balance.tickmodel import PhaseModel
 from imitwalk.errors import ConfigError
-from imitwalk.lqr import Costs, horizon_gains, state_space
-from imitwalk.tickmodel import PhaseModel
 
 
 def _model(A1, A2, B1, B2) -> PhaseModel:
@@ -134,8 +134,8 @@ def test_one_state_weight_per_model_state():
 
 def test_gains_of_a_fitted_model_are_those_of_the_system_it_was_fitted_on():
     """The learner's path: record, fit the per-tick model, derive the gains."""
-    from imitwalk.channels import FEATURES
-    from imitwalk.feedback import Episode, FeedbackLaw
+    from imitwalk.balance.channels import FEATURES
+    from imitwalk.balance.feedback import Episode, FeedbackLaw
 
     a1, a2, b1, b2, N = 0.9, -0.2, 0.4, 0.1, 10  # a second-order system: no collinear inputs
     rng = np.random.default_rng(3)

@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.metrics import SATURATED, walk_metrics
-from imitwalk.simtypes import Rollout
+from imitwalk.sim.metrics import SATURATED, walk_metrics
+from imitwalk.sim.types import Rollout
 
 
 def _rollout(torque=None, limit=None, n=100):

@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from bvh_writer import M_Z_UP, load_rig, write_bvh
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import MocapError
 from imitwalk.mocap import LOWER_BODY, load_motion
 from imitwalk.mocap._common import UP_AXES, UP_TO_Z_UP
@@ -350,8 +350,8 @@ def test_bad_bvh_through_a_real_process(shared_mocap, tmp_path):
 @pytest.mark.parametrize("command", ["retarget", "learn"])
 def test_cli_mocap_flags(shared_mocap, tmp_path, command):
     """``--up``, ``--units`` and ``--joint-names`` reach the reader from both commands."""
-    from imitwalk.cli import build_parser
-    from imitwalk.commands import _motion
+    from imitwalk.cli.commands import _motion
+    from imitwalk.cli.main import build_parser
 
     rig = _rig(str(shared_mocap))
     silent = _silent(rig)

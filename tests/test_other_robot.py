@@ -10,7 +10,7 @@ import numpy as np
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.robots import BUILTIN, load_robot
-from imitwalk.sim import MujocoPlant, playback
+from imitwalk.sim.mujoco import MujocoPlant, playback
 
 HOAP2 = BUILTIN["hoap2"].parent
 

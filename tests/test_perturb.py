@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from imitwalk.errors import ConfigError
-from imitwalk.perturb import FACTORS, perturbed
-from imitwalk.simtypes import SimOptions
+from imitwalk.sim.perturb import FACTORS, perturbed
+from imitwalk.sim.types import SimOptions
 
 #: the fields of SimOptions each factor sets
 FIELDS = {

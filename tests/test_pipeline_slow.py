@@ -7,8 +7,8 @@ import json
 import pytest
 
 from conftest import TICK, sets
-from imitwalk.cli import main
-from imitwalk.tickconfig import LqrConfig, TrialConfig
+from imitwalk.balance.tickconfig import LqrConfig, TrialConfig
+from imitwalk.cli.main import main
 
 #: A small reference search.
 SEARCH = [

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from imitwalk.errors import ConfigError
-from imitwalk.predictor import PredictionReport, SensoryMotorModel, encode_action
+from imitwalk.paper.predictor import PredictionReport, SensoryMotorModel, encode_action
 
 
 def drive(a: np.ndarray) -> np.ndarray:

@@ -7,12 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import ConfigError
-from imitwalk.perturb import perturbed
-from imitwalk.protocol import FACTORS, PROTOCOLS, load_protocol
+from imitwalk.judge.protocol import FACTORS, PROTOCOLS, load_protocol
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, SimOptions, make_plant
+from imitwalk.sim.mujoco import MujocoPlant, SimOptions, make_plant
+from imitwalk.sim.perturb import perturbed
 
 
 @pytest.fixture(scope="module")

@@ -5,10 +5,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from imitwalk import pushes
 from imitwalk.errors import ConfigError
-from imitwalk.pushes import DIRECTIONS, PHASES, STEPS, PushJob, kick_time, push_recovery, top_speed
-from imitwalk.replay import load_run
+from imitwalk.judge import pushes
+from imitwalk.judge.pushes import (
+    DIRECTIONS,
+    PHASES,
+    STEPS,
+    PushJob,
+    kick_time,
+    push_recovery,
+    top_speed,
+)
+from imitwalk.judge.replay import load_run
 
 
 def _threshold(job: PushJob) -> float:

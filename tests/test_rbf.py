@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from sklearn.exceptions import NotFittedError
 
 from imitwalk.errors import ConfigError
-from imitwalk.rbf import COVARIANCES, RBFNetwork
+from imitwalk.paper.rbf import COVARIANCES, RBFNetwork
 
 
 def smooth(A: np.ndarray) -> np.ndarray:

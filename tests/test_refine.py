@@ -9,11 +9,11 @@ import pytest
 
 from imitwalk.errors import ConfigError
 from imitwalk.parallel import run_parallel
-from imitwalk.perturb import TRAIN_SEED_BASE
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
 from imitwalk.retarget import refine as refine_mod
 from imitwalk.retarget.refine import STEPS, refine_params, refine_per_scale
 from imitwalk.retarget.search import BOUNDS, SearchConfig
+from imitwalk.sim.perturb import TRAIN_SEED_BASE
 
 
 @dataclass
@@ -62,7 +62,7 @@ def stubbed(monkeypatch):
 
     monkeypatch.setattr(refine_mod, "WalkIK", lambda robot: None)
     monkeypatch.setattr(refine_mod, "build_walkable", build)
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_play))
+    monkeypatch.setattr("imitwalk.sim.playback.play_reference", _stops(_play))
     return played
 
 
@@ -113,7 +113,9 @@ def _with_sway(play, sway: float):
 
 def test_early_stop_keeps_the_same_sets_and_plays_fewer_robots(stubbed, monkeypatch):
     start = GaitParams(lean=0.0, ds=0.1, lift=BOUNDS["lift"][0])
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_with_sway(_play, start.sway)))
+    monkeypatch.setattr(
+        "imitwalk.sim.playback.play_reference", _stops(_with_sway(_play, start.sway))
+    )
     cfg = SearchConfig(refine_rounds=5, refine_models=10, refine_seconds=4.0)
     full_params, full = refine_params(None, None, start, replace(cfg, refine_early_stop=False))
     stubbed.clear()
@@ -143,7 +145,9 @@ def test_early_stop_keeps_the_same_sets_and_plays_fewer_robots(stubbed, monkeypa
 
 def test_early_stop_in_the_per_scale_refinement(stubbed, monkeypatch):
     start = GaitParams(lean=0.0, ds=0.1)
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(_with_sway(_play, start.sway)))
+    monkeypatch.setattr(
+        "imitwalk.sim.playback.play_reference", _stops(_with_sway(_play, start.sway))
+    )
     cfg = SearchConfig(refine_rounds=3, refine_scales=(1.0, 0.8), refine_models=5)
     full_own, full = refine_per_scale(None, None, start, replace(cfg, refine_early_stop=False))
     own, rep = refine_per_scale(None, None, start, cfg)
@@ -160,7 +164,7 @@ def test_a_nudge_that_costs_progress_is_not_kept(stubbed, monkeypatch):
             SimpleNamespace(metrics=_Metrics(i < n, seconds, prog, 0.0)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
+    monkeypatch.setattr("imitwalk.sim.playback.play_reference", _stops(play))
     cfg = SearchConfig(refine_rounds=2, refine_models=6, refine_seconds=4.0)
     params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
     assert params.lean == 0.0 and rep["falls"] == rep["start_falls"] == 2 * 3
@@ -176,7 +180,7 @@ def test_with_a_yaw_slack_a_nudge_that_turns_the_walk_is_not_kept(stubbed, monke
             SimpleNamespace(metrics=_Metrics(i < n, seconds, 1.0, yaw)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
+    monkeypatch.setattr("imitwalk.sim.playback.play_reference", _stops(play))
     cfg = SearchConfig(refine_rounds=3, refine_models=6, refine_seconds=4.0)
     params, rep = refine_params(None, None, GaitParams(lean=0.0, ds=0.14), cfg)
     assert params.lean == pytest.approx(0.003) and rep["falls"] == 0  # heading not guarded
@@ -204,7 +208,7 @@ def test_per_scale_refinement_finds_each_scale_its_own_set(stubbed, monkeypatch)
             SimpleNamespace(metrics=_Metrics(i < n, seconds, 1.0, 0.0)) for i in range(len(seeds))
         ]
 
-    monkeypatch.setattr("imitwalk.playback.play_reference", _stops(play))
+    monkeypatch.setattr("imitwalk.sim.playback.play_reference", _stops(play))
     cfg = SearchConfig(
         refine_rounds=4, refine_scales=(1.0, 0.8), refine_models=5, refine_early_stop=False
     )
@@ -315,7 +319,7 @@ def test_a_reference_can_be_solved_with_its_own_parameters_at_some_scales(robot,
 
 
 def test_the_command_line_shows_each_refinement_trial(capsys):
-    from imitwalk.commands import refine_report
+    from imitwalk.cli.commands import refine_report
     from imitwalk.retarget.refine import RefineTrial
 
     trial = RefineTrial({}, "lean+", 3, 72, 29.0, 0.9, 4.0, kept=True)
@@ -324,7 +328,7 @@ def test_the_command_line_shows_each_refinement_trial(capsys):
     refine_report(3, 75, RefineTrial({}, "ds-", 2, 24, 29.0, 0.9, 4.0, kept=True, at=1.0))
     err = capsys.readouterr().err.splitlines()
     # retarget and learn announce the refinement before the search starts
-    from imitwalk.commands import _announce_search
+    from imitwalk.cli.commands import _announce_search
 
     _announce_search(RetargetConfig(search_config=SearchConfig(refine_rounds=2)))
     per = SearchConfig(refine_rounds=1, refine_per_scale=True, refine_scales=(0.9, 1.0))

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from conftest import TINY
+from imitwalk.balance.feedback import TickPolicy
 from imitwalk.config import apply_overrides
 from imitwalk.errors import ConfigError, RunError
-from imitwalk.feedback import TickPolicy
-from imitwalk.learnconfig import preset
-from imitwalk.learner import learn
-from imitwalk.policy import WalkPolicy
-from imitwalk.replay import OPEN_LOOP, load_run
+from imitwalk.judge.replay import OPEN_LOOP, load_run
+from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learner import learn
+from imitwalk.paper.policy import WalkPolicy
 from imitwalk.runs import RunDir
 
 

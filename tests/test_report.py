@@ -10,13 +10,13 @@ import shutil
 import pytest
 
 from conftest import TINY, _missing
-from imitwalk import pushes
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
-from imitwalk.learnconfig import preset
-from imitwalk.learner import learn
-from imitwalk.replay import load_run
-from imitwalk.report import write_report
+from imitwalk.evidence.report import write_report
+from imitwalk.judge import pushes
+from imitwalk.judge.replay import load_run
+from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learner import learn
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import RunDir
 
@@ -125,8 +125,8 @@ def test_missing_files_are_said(bare_report):
 
 
 def test_figures_take_empty_data(run_dir):
-    from imitwalk import curves, plots
-    from imitwalk.report import _display_gait
+    from imitwalk.evidence import curves, plots
+    from imitwalk.evidence.report import _display_gait
 
     lr = load_run(run_dir)
     gait = _display_gait(lr)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import ImitwalkError, RobotError
 from imitwalk.robots import BUILTIN, ROLES, load_robot
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from imitwalk.servo import StablePD
+from imitwalk.sim.servo import StablePD
 
 
 def _simulate(torque_fn, inertia: float, load: float, dt: float, steps: int) -> np.ndarray:

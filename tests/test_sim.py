@@ -7,12 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 from imitwalk.errors import ImitwalkError
-from imitwalk.metrics import tilt_deg
 from imitwalk.robots import load_robot
-from imitwalk.sim import MujocoPlant, Plant, SimOptions, make_plant, playback
-from imitwalk.standing import stand_test
+from imitwalk.sim.metrics import tilt_deg
+from imitwalk.sim.mujoco import MujocoPlant, Plant, SimOptions, make_plant, playback
+from imitwalk.sim.standing import stand_test
 
 
 @pytest.fixture(scope="module")
@@ -180,7 +180,7 @@ def test_initial_twist(robot):
 
 
 def test_a_policy_that_declares_its_start_posture_starts_there(robot):
-    from imitwalk.sim import run
+    from imitwalk.sim.mujoco import run
 
     bent = robot.stand.copy()
     bent[robot.joint_names.index("l_knee")] += 0.2

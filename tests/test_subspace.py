@@ -10,7 +10,7 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 
 from imitwalk.errors import ConfigError
-from imitwalk.subspace import PostureSubspace
+from imitwalk.paper.subspace import PostureSubspace
 
 
 def low_rank(seed: int, T: int, n: int, rank: int) -> np.ndarray:

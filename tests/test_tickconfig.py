@@ -8,9 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from imitwalk.balance.tickconfig import LqrConfig, TickLearnConfig, TrialConfig
 from imitwalk.config import apply_overrides, from_dict, to_dict
 from imitwalk.errors import ConfigError
-from imitwalk.tickconfig import LqrConfig, TickLearnConfig, TrialConfig
 
 #: (setting, a value outside its range, the range the message gives)
 OUT_OF_RANGE = [

@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 from conftest import TICK, sets, strip_log, strip_wall
-from imitwalk.cli import main
+from imitwalk.balance.feedback import FeedbackLaw
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.ticklearn import learn_tick
+from imitwalk.balance.tickstore import TRIAL_GAINS, load_laws, unstack_episodes
+from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
 from imitwalk.errors import RunError
-from imitwalk.feedback import FeedbackLaw
 from imitwalk.retarget import Reference
 from imitwalk.runs import RunDir
-from imitwalk.tickconfig import TickLearnConfig
-from imitwalk.ticklearn import learn_tick
-from imitwalk.tickstore import TRIAL_GAINS, load_laws, unstack_episodes
 
 
 def _config(extra=()) -> TickLearnConfig:

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from sklearn.exceptions import NotFittedError
 
-from imitwalk.channels import FEATURES
+from imitwalk.balance.channels import FEATURES
+from imitwalk.balance.feedback import Episode, FeedbackLaw
+from imitwalk.balance.tickmodel import PhaseModel, nominal_profile, regressors
 from imitwalk.errors import ConfigError
-from imitwalk.feedback import Episode, FeedbackLaw
-from imitwalk.tickmodel import PhaseModel, nominal_profile, regressors
 
 #: The synthetic walk: loop ticks, its states (features) and actions (channels).
 N = 12

@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.tickrun import TickResult, Trial
+from imitwalk.balance.tickrun import TickResult, Trial
 
 
 def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> Trial:

@@ -1,5 +1,5 @@
 """``python -m imitwalk`` runs the command-line tool."""
 
-from imitwalk.cli import main
+from imitwalk.cli.main import main
 
 raise SystemExit(main())

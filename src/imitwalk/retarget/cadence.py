@@ -6,7 +6,7 @@ sets it once for a whole reference: the loop is played ``rate`` times as fast â€
 strides and postures, cycles a whole number of ticks shorter. The start-up from standing
 keeps the human's cadence (played faster, it tips the robot over within three seconds),
 and its last tick still flows into the loop's first; the balance channels then start
-their step clock at the loop (:class:`imitwalk.policy.WalkPolicy`).
+their step clock at the loop (:class:`imitwalk.paper.policy.WalkPolicy`).
 ``imitwalk retarget --set cadence=R`` writes such a reference, and the learner's trials
 (``LearnConfig.cadences``, :mod:`imitwalk.trust`) can pick the rate.
 """

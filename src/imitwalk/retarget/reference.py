@@ -17,7 +17,7 @@ import numpy as np
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.retarget.command import GaitCommand, advance
-from imitwalk.simtypes import SimOptions
+from imitwalk.sim.types import SimOptions
 
 __all__ = ["PLAN_KEYS", "Reference", "plan_arrays"]
 

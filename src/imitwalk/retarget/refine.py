@@ -19,7 +19,7 @@ whole story: on the default clip the kept nudges took the mean |heading drift| o
 trials from 11.5° to 26.7°. ``refine_yaw_slack`` (off by default) keeps a nudge only if
 the walk drifts at most that many degrees more than the searched reference. It stops
 after ``refine_rounds`` rounds, earlier when a whole round keeps nothing or when nothing
-falls. Like the search it uses training robots only (:func:`imitwalk.perturb.train_seeds`),
+falls. Like the search it uses training robots only (:func:`imitwalk.sim.perturb.train_seeds`),
 never an evaluation robot, and no dynamics model: it measures.
 
 A nudge is kept only if it falls less often than the set it must beat, so once its falls
@@ -43,7 +43,6 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from imitwalk.perturb import train_seeds
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.params import GaitParams, leg_scaled
@@ -51,7 +50,8 @@ from imitwalk.retarget.search import LENGTHS, bounds
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
-from imitwalk.simtypes import SimOptions
+from imitwalk.sim.perturb import train_seeds
+from imitwalk.sim.types import SimOptions
 
 __all__ = ["PROGRESS_SLACK", "STEPS", "RefineTrial", "refine_params", "refine_per_scale"]
 
@@ -110,7 +110,7 @@ class RefineTrial:
 
 
 def _falls(runs) -> int:
-    """How many of ``runs`` (:class:`~imitwalk.playback.ModelRun`) fell."""
+    """How many of ``runs`` (:class:`~imitwalk.sim.playback.ModelRun`) fell."""
     return sum(r.metrics.fell for r in runs)
 
 
@@ -140,7 +140,7 @@ def refine_params(
     Returns:
         the kept parameters and a JSON-able report of every trial.
     """
-    from imitwalk.playback import play_reference  # it imports this package
+    from imitwalk.sim.playback import play_reference  # it imports this package
 
     scales = [at] if at is not None else sorted(config.refine_scales)
     seeds = train_seeds(config.refine_models)

@@ -21,9 +21,7 @@ from dataclasses import asdict, dataclass, fields, replace
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
-from imitwalk.metrics import walk_metrics
 from imitwalk.parallel import run_parallel
-from imitwalk.perturb import perturbed, train_seeds
 from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
@@ -33,8 +31,10 @@ from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
-from imitwalk.sim import SimOptions, make_plant, playback
-from imitwalk.simtypes import ENGINES
+from imitwalk.sim.metrics import walk_metrics
+from imitwalk.sim.mujoco import SimOptions, make_plant, playback
+from imitwalk.sim.perturb import perturbed, train_seeds
+from imitwalk.sim.types import ENGINES
 
 __all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "bounds", "search_cadence", "search_params"]
 
@@ -72,7 +72,7 @@ class SearchConfig:
             on 2 of 6 robots at scale 0.5; 4 doubles the search's cost and fixed that.
         seconds: simulated time per rollout [s]; seed: the search's random seed.
         workers: parallel processes (``None``: one per core).
-        engine: the physics engine of the trials (:data:`imitwalk.simtypes.ENGINES`).
+        engine: the physics engine of the trials (:data:`imitwalk.sim.types.ENGINES`).
         cadences: candidate cadence rates (0.5–2; 1: the human's) for
             :func:`search_cadence`, tried after the parameters; empty: not searched.
         cadence_models, cadence_seconds: robots (the nominal one + training
@@ -246,7 +246,7 @@ def search_cadence(
     Returns:
         the rate (relative to ``ref``'s cadence) and a JSON-able report of every trial.
     """
-    from imitwalk.playback import play_reference  # it imports this package
+    from imitwalk.sim.playback import play_reference  # it imports this package
 
     scale = max(config.scales)
     seeds = train_seeds(config.cadence_models)

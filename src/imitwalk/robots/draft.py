@@ -128,7 +128,7 @@ def draft_joint_map(mjcf: str | Path, out: str | Path) -> Draft:
             that cannot be guessed; a robot that falls in its standing posture.
     """
     from imitwalk.robots.posture import solve_stand
-    from imitwalk.standing import stand_test
+    from imitwalk.sim.standing import stand_test
 
     mjcf, out = Path(mjcf), Path(out)
     model = compile_model(mjcf)

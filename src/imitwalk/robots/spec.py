@@ -38,7 +38,7 @@ TRUNK_ROLES: tuple[str, ...] = ("waist_yaw", "neck_yaw", "neck_pitch")
 ROLES: tuple[str, ...] = LEG_ROLES + ARM_ROLES + TRUNK_ROLES
 
 #: A standing posture that is not the file's own keyframe is lowered onto the floor: its
-#: lowest sole this far above it [m] (as :meth:`imitwalk.sim.MujocoPlant.reset` does).
+#: lowest sole this far above it [m] (as :meth:`imitwalk.sim.mujoco.MujocoPlant.reset` does).
 SOLE_CLEARANCE = 1e-4
 
 

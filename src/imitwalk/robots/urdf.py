@@ -1,9 +1,9 @@
-"""A robot's MJCF, written out as URDF for a second physics engine (``imitwalk.bullet``).
+"""A robot's MJCF, written out as URDF for a second physics engine (``imitwalk.sim.bullet``).
 
 The URDF is built from the *compiled* MuJoCo model, so it carries exactly the masses,
 inertias (MuJoCo's, from the geometric primitives), joint axes, ranges and collision
 shapes that MuJoCo simulates. What URDF cannot say is left out and listed in
-:data:`NOT_CARRIED`; :class:`imitwalk.bullet.BulletPlant` adds the servos itself.
+:data:`NOT_CARRIED`; :class:`imitwalk.sim.bullet.BulletPlant` adds the servos itself.
 
 Frames: each URDF link sits at its MuJoCo body's frame moved to the body's hinge (URDF
 joints turn about the child link's origin), with the body's orientation. Bodies without

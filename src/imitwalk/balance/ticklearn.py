@@ -1,0 +1,315 @@
+"""Learning to balance every tick: trial-picked feedback, then the paper's loop on top.
+
+Three stages, each checkpointed, so that an interrupted run resumes where it stopped
+and ends where an uninterrupted one would:
+
+1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
+   roll, heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
+   chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
+   many short walks of training robots. This is the baseline; the learned law starts
+   from it.
+2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
+   robots (with exploration in a scale's first iteration), record, fit the per-tick
+   model of eqs. 3–4 (:class:`~imitwalk.balance.tickmodel.PhaseModel`), turn it into gains by
+   the receding-horizon eq.-6 search (:func:`~imitwalk.balance.lqr.horizon_gains`) and go on;
+   a scale is passed by an iteration without exploration in which no training robot
+   falls. The learned law acts on top of the trial-picked one.
+3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the top
+   scale, on the trials' robots; the smallest fraction that falls least is kept (0: the
+   trial-picked law alone).
+
+``scale_reached`` is the top scale if the kept law walked every trial robot there without
+a fall, else the highest scale the schedule passed (the first if none): the run's
+controllers are judged there. ``scales_passed`` says how far the schedule carried the
+model-based law.
+
+Training robots come from ``train_protocol`` with seeds no evaluation uses.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field, replace
+
+from imitwalk.balance.feedback import Episode, FeedbackLaw
+from imitwalk.balance.lqr import Costs, horizon_gains
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.tickmodel import PhaseModel, nominal_profile
+from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode, summarize
+from imitwalk.balance.tickstore import (
+    TRIAL_GAINS,
+    feedback_law,
+    load_learned,
+    save_learned,
+    stack_episodes,
+    unstack_episodes,
+)
+from imitwalk.config import to_dict
+from imitwalk.errors import RunError
+from imitwalk.judge.protocol import load_protocol
+from imitwalk.parallel import run_parallel
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+from imitwalk.sim.perturb import TRAIN_SEED_BASE, TRIAL_SEED_BASE
+
+__all__ = ["TickProgress", "learn_tick"]
+
+
+@dataclass
+class TickProgress:
+    """Where a run is (``checkpoint.json``); nothing else crosses the stages.
+
+    Attributes:
+        stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
+        gains: the trial-picked gains so far, by setting name; trial: the next gain.
+        scale_index, iteration: where the schedule is; passed: scales passed.
+        trust: the fraction of the learned law kept (``None`` until decided).
+        tried: every candidate's trial results so far, by key (run once each).
+        sim_seconds, wall_seconds: what learning has cost so far [s].
+    """
+
+    stage: str = "trials"
+    gains: dict = field(default_factory=dict)
+    trial: int = 0
+    scale_index: int = 0
+    iteration: int = 0
+    passed: list = field(default_factory=list)
+    trust: float | None = None
+    tried: dict = field(default_factory=dict)
+    sim_seconds: float = 0.0
+    wall_seconds: float = 0.0
+
+
+class _Learner:
+    """The stages' shared context: the run folder, the robots and the budget."""
+
+    def __init__(self, ref: Reference, robot: Robot, cfg: TickLearnConfig, rd: RunDir, progress):
+        self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
+        self.say = progress or (lambda _line: None)
+        self.protocol = load_protocol(cfg.train_protocol)
+        self.scales = cfg.scales()
+        self.ref_path = str(rd.file("reference.npz"))
+
+    def robots(self, n: int, first: int, seconds: float):
+        return [
+            self.protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds)
+            for j in range(n)
+        ]
+
+    def run(self, state: TickProgress, scale, laws, draws, seconds, explore=0.0, rng=0):
+        t0 = time.perf_counter()
+        jobs = [
+            TickJob(
+                self.ref_path,
+                self.robot,
+                scale,
+                tuple(laws),
+                d.seed,
+                d.options,
+                seconds,
+                explore,
+                (self.cfg.seed, rng, j),
+                self.cfg.engine,
+            )
+            for j, d in enumerate(draws)
+        ]
+        out = run_parallel(run_tick_episode, jobs, self.cfg.workers)
+        state.sim_seconds += sum(r.seconds for r in out)
+        state.wall_seconds += time.perf_counter() - t0
+        return out
+
+
+def _trial(lr: _Learner, state: TickProgress, key: str, laws, heading: bool = False) -> Trial:
+    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), run
+    once per key (kept in the checkpoint, so that a resumed run neither repeats nor
+    re-counts them)."""
+    t = lr.cfg.trials
+    n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
+    key = f"{key}@{n}x{seconds:g}s"
+    if key not in state.tried:
+        top = lr.scales[-1]
+        res = lr.run(state, top, laws, lr.robots(n, TRIAL_SEED_BASE + 1, seconds), seconds)
+        state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
+    return Trial([TickResult(**r) for r in state.tried[key]])
+
+
+def _gains_key(gains: dict, extra: str = "") -> str:
+    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS) + extra
+
+
+def _say_table(lr: _Learner, head: str, table) -> None:
+    """One progress line: per candidate, its falls and mean |yaw|."""
+    cells = []
+    for v, t in table:
+        s = t.summary()
+        cells.append(f"[{v:g}: {s['falls']}/{s['robots']} fell, {s['abs_yaw_deg']:.1f} deg]")
+    lr.say(f"{head} {' '.join(cells)}")
+
+
+def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
+    """Stage 1: one gain at a time, each from its candidates, at the top scale."""
+    cfg = lr.cfg
+    while state.trial < len(TRIAL_GAINS):
+        name, channel, feature, steers = TRIAL_GAINS[state.trial]
+        limit = cfg.trials.yaw_limit_deg if steers else None
+        table = []
+        for value in getattr(cfg.trials, name):
+            gains = {**state.gains, name: float(value)}
+            laws = [feedback_law(cfg, gains)]
+            table.append((float(value), _trial(lr, state, _gains_key(gains), laws, steers)))
+        best = min(table, key=lambda row: row[1].rank(row[0], limit))[0]
+        state.gains[name] = best
+        log.append(
+            {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
+             "kept": best, "table": [{"value": v, **t.summary()} for v, t in table]}
+        )  # fmt: skip
+        _say_table(lr, f"trials: {feature} -> {channel} = {best:g}", table)
+        state.trial += 1
+        _checkpoint(lr, state, log)
+    state.stage = "schedule" if cfg.lqr.enabled else "done"
+
+
+def _learned_law(lr: _Learner, episodes: list[Episode]):
+    """Fit the model on ``episodes`` and turn it into the learned law (and the model);
+    the states are the features less their mean at each phase in ``episodes``."""
+    c = lr.cfg.lqr
+    n = lr.ref.loops.shape[1]
+    shell = FeedbackLaw.zero(c.channels, c.features, c.box, n_ticks=n, memory=True)
+    shell = replace(shell, nominal=nominal_profile(episodes, c.features, n))
+    model = PhaseModel(n_phases=n, width=c.width, ridge=c.ridge).fit(episodes, shell)
+    costs = Costs(c.costs(), c.action_cost, c.change_cost, c.horizon)
+    return replace(shell, gains=horizon_gains(model, costs)), model
+
+
+def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
+    """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
+    cfg = lr.cfg
+    base = feedback_law(cfg, state.gains)
+    learned, model = load_learned(lr.rd), None
+    if data and state.scale_index < len(lr.scales):  # resumed: the model of the last iteration
+        last = log[-1]["scale"] if log and log[-1].get("stage") == "schedule" else None
+        if last is not None:
+            learned, model = _learned_law(lr, [e for s, e in data if abs(s - last) < 1e-9])
+    while state.scale_index < len(lr.scales):
+        scale = lr.scales[state.scale_index]
+        explore = cfg.lqr.explore if state.iteration == 0 else 0.0
+        n = len(log)
+        draws = lr.robots(cfg.robots, TRAIN_SEED_BASE + 1 + cfg.robots * n, cfg.seconds)
+        laws = [base] if learned is None else [base, learned]
+        if learned is None:  # the first iteration records the trial-picked law's channels
+            laws = [base, FeedbackLaw.zero(cfg.lqr.channels, cfg.lqr.features, cfg.lqr.box)]
+        res = lr.run(state, scale, laws, draws, cfg.seconds, explore, rng=n)
+        new = [(scale, r.episode) for r in res if r.episode is not None]
+        held = None
+        if model is not None:  # the last model, on episodes it has not seen
+            pred = model.score_episodes([e for _, e in new], learned)
+            held = pred.to_dict() if pred else None
+        data.extend(new)
+        near = [e for s, e in data if abs(s - scale) < 1e-9]
+        learned, model = _learned_law(lr, near)
+        fell = sum(r.fell for r in res)
+        entry = {"stage": "schedule", "scale": scale, "iteration": state.iteration,
+                 "explore": explore, **summarize(res), "held_out": held}  # fmt: skip
+        log.append(entry)
+        ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
+        lr.say(
+            f"scale {scale:.2f} it {state.iteration} | fell {fell}/{len(res)} | "
+            f"cost {entry['cost']:.3f} | model err / persistence {ratio}"
+        )
+        if explore == 0.0 and fell == 0:
+            state.passed.append(scale)
+            state.scale_index, state.iteration = state.scale_index + 1, 0
+        elif state.iteration + 1 >= cfg.iterations:
+            break
+        else:
+            state.iteration += 1
+        save_learned(lr.rd, learned)
+        _checkpoint(lr, state, log, data)
+    save_learned(lr.rd, learned)
+    state.stage = "trust"
+    return learned
+
+
+def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
+    """Stage 3: how much of the learned law to keep, by the trials at the top scale (the
+    law the schedule learned at the highest scale it passed)."""
+    cfg = lr.cfg
+    if learned is None:
+        state.trust, state.stage = 0.0, "done"
+        return
+    base = feedback_law(cfg, state.gains)
+    table = []
+    for frac in cfg.lqr.trust:
+        laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
+        key = _gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
+        table.append((float(frac), _trial(lr, state, key, laws)))
+    best = min(table, key=lambda row: row[1].rank(row[0]))[0]
+    state.trust, state.stage = best, "done"
+    log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
+                "table": [{"fraction": f, **t.summary()} for f, t in table]})  # fmt: skip
+    _say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
+
+
+def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None = None) -> None:
+    if data is not None:
+        lr.rd.write_arrays("data.npz", stack_episodes(data))
+    lr.rd.write_log(log)
+    lr.rd.write_json("checkpoint.json", asdict(state))
+
+
+def learn_tick(
+    ref: Reference, robot: Robot, config: TickLearnConfig, run_dir, resume=False, progress=None
+) -> dict:
+    """Learn to walk ``ref`` on ``robot`` with per-tick feedback; write ``run_dir``.
+
+    Returns:
+        the summary, also written as ``metrics.json``.
+    """
+    rd = RunDir(run_dir)
+    cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
+                "learner": "tick"}  # fmt: skip
+    if resume:
+        if not rd.exists("checkpoint.json"):
+            raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
+        if rd.read_json("config.json")["learn"] != cfg_json["learn"]:
+            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        state = TickProgress(**rd.read_json("checkpoint.json"))
+        log = rd.read_log()
+        data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
+    else:
+        if rd.exists("checkpoint.json"):
+            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        rd.path.mkdir(parents=True, exist_ok=True)
+        rd.write_json("config.json", cfg_json)
+        ref.save(rd.file("reference.npz"))
+        state, log, data = TickProgress(), [], []
+    lr = _Learner(ref, robot, config, rd, progress)
+    if state.stage == "trials":
+        _trials(lr, state, log)
+        _checkpoint(lr, state, log, data)
+    learned = load_learned(rd)
+    if state.stage == "schedule":
+        learned = _schedule(lr, state, log, data)
+        _checkpoint(lr, state, log, data)
+    if state.stage == "trust":
+        _trust(lr, state, log, learned)
+        _checkpoint(lr, state, log, data)
+    kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
+    row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
+    top_falls = int(row["falls"])
+    reached = lr.scales[-1] if top_falls == 0 else max(state.passed, default=lr.scales[0])
+    summary = {
+        "learner": "tick",
+        "scale_reached": reached,
+        "trial_falls_at_top": top_falls,
+        "scales_passed": state.passed,
+        "feedback_gains": state.gains,
+        "trust": state.trust,
+        "iterations": sum(1 for e in log if e["stage"] == "schedule"),
+        "sim_seconds_used_for_learning": state.sim_seconds,
+        "wall_seconds_for_learning": state.wall_seconds,
+        "config": to_dict(config),
+    }
+    rd.write_json("metrics.json", summary)
+    return summary

@@ -1,0 +1,144 @@
+"""One episode of the per-tick controller on one training robot, and its record.
+
+The learner (:mod:`imitwalk.balance.ticklearn`) runs many of these in parallel
+(:func:`imitwalk.parallel.run_parallel`); only the simulator steps the physics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
+from imitwalk.robots import Robot
+from imitwalk.sim.types import SimOptions
+
+__all__ = ["TickJob", "TickResult", "Trial", "run_tick_episode", "summarize"]
+
+
+@dataclass(frozen=True)
+class TickJob:
+    """One episode.
+
+    Attributes:
+        ref_path: the reference (``.npz``); robot: the robot; scale: stride scale;
+        laws: the feedback laws (their outputs add up); seed: the training robot;
+        options: its simulation; seconds: simulated time [s]; explore: exploration
+        amplitude [rad] on the last law; rng: the exploration's seed; engine: the
+        physics engine; record: return the recorded episode.
+    """
+
+    ref_path: str
+    robot: Robot
+    scale: float
+    laws: tuple[FeedbackLaw, ...]
+    seed: int
+    options: SimOptions
+    seconds: float
+    explore: float = 0.0
+    rng: tuple[int, ...] = (0,)
+    engine: str = "mujoco"
+    record: bool = True
+
+
+@dataclass(frozen=True)
+class TickResult:
+    """What one episode gave.
+
+    Attributes:
+        seed: the training robot; fell: whether it fell; fall_time_s: when [s];
+        seconds: simulated time [s]; distance_m: forward travel [m]; yaw_drift_deg;
+        cost: the measured eq.-6 cost Γ, the mean of |gyro|² over the walk [rad²/s²];
+        episode: the recorded ticks (``None`` unless asked for).
+    """
+
+    seed: int
+    fell: bool
+    fall_time_s: float | None
+    seconds: float
+    distance_m: float
+    yaw_drift_deg: float
+    cost: float
+    episode: Episode | None = None
+
+    def score(self) -> tuple[float, float]:
+        """How a trial ranks it: a fall first (and sooner is worse), then the cost."""
+        return (float(self.fell), self.cost)
+
+
+_REFS: dict = {}
+
+
+def _reference(path: str):
+    from imitwalk.retarget.reference import Reference
+
+    if path not in _REFS:
+        _REFS.clear()
+        _REFS[path] = Reference.load(path)
+    return _REFS[path]
+
+
+def run_tick_episode(job: TickJob) -> TickResult:
+    """Walk ``job``'s laws on its robot (runs in a worker process)."""
+    from imitwalk.sim.metrics import walk_metrics
+    from imitwalk.sim.mujoco import make_plant, run
+
+    ref = _reference(job.ref_path)
+    policy = TickPolicy(
+        ref, job.scale, job.laws, job.robot.joint_names, job.seconds, job.explore, seed=job.rng
+    )
+    plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
+    ro = run(plant, policy, len(policy.q_ref))
+    m = walk_metrics(
+        ro,
+        ref.expected_distance(job.scale, ro.seconds),
+        policy.q_ref,
+        ref.track(job.scale, ro.seconds),
+    )
+    walk = ro.gyro[ref.starts.shape[1] - ref.loops.shape[1] :]  # from the last start-up cycle
+    cost = float(np.mean(np.sum(walk**2, axis=1))) if len(walk) else float("inf")
+    return TickResult(
+        seed=job.seed,
+        fell=m.fell,
+        fall_time_s=m.fall_time_s,
+        seconds=m.seconds,
+        distance_m=m.forward_distance_m,
+        yaw_drift_deg=m.yaw_drift_deg,
+        cost=cost if not m.fell else float("inf"),
+        episode=policy.episode() if job.record else None,
+    )
+
+
+def summarize(results: list[TickResult]) -> dict:
+    """Falls, robots, mean Γ of the robots that stayed up [rad²/s²], seconds walked [s],
+    mean forward distance [m] and mean |yaw| [deg] of some walks."""
+    up = [r for r in results if not r.fell]
+    return {
+        "falls": int(sum(r.fell for r in results)),
+        "robots": len(results),
+        "cost": float(np.mean([r.cost for r in up])) if up else float("inf"),
+        "walked_s": float(sum(r.seconds for r in results)),
+        "distance_m": float(np.mean([r.distance_m for r in results])),
+        "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
+    }
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One candidate's walks at the top scale, on the training robots."""
+
+    results: list
+
+    def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
+        """The order candidates are kept in (least first): the fewest falls; then, where
+        the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
+        beyond that limit; then the smallest ``|value|``. A lower
+        Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
+        the gain where robots start to fall (docs/RESULTS.md)."""
+        s = self.summary()
+        drift = 0.0 if yaw_limit_deg is None else max(0.0, s["abs_yaw_deg"] - yaw_limit_deg)
+        return (s["falls"], drift, abs(value))
+
+    def summary(self) -> dict:
+        return summarize(self.results)

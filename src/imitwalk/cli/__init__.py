@@ -1,0 +1,5 @@
+"""The ``imitwalk`` command line (:mod:`imitwalk.cli.main`)."""
+
+from imitwalk.cli.main import main
+
+__all__ = ["main"]

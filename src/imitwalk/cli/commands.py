@@ -1,0 +1,318 @@
+"""The work behind each CLI subcommand (parsing lives in :mod:`imitwalk.cli.main`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk.cli.progress import progress
+
+__all__ = [
+    "emit",
+    "playback",
+    "progress",
+    "retarget",
+    "robot_from",
+]
+
+
+def emit(obj: dict, as_json: bool, finite: bool = False) -> None:
+    """Print ``obj`` as JSON, or as aligned ``key: value`` lines; ``finite``: a NaN or an
+    infinity (a servo without a torque limit) is printed as ``null``, so the JSON is valid."""
+    if finite:
+        obj = _finite(obj)
+    if as_json:
+        print(json.dumps(obj, indent=2, default=_plain, allow_nan=not finite))
+        return
+    for key, val in obj.items():
+        if isinstance(val, dict | list):
+            text = json.dumps(val, default=_plain)
+            val = text if len(text) <= 90 else text[:87] + "..."
+        elif isinstance(val, float):
+            val = f"{val:.4g}"
+        print(f"{key:>28}: {val}")
+
+
+def _finite(v):
+    """``v`` with every non-finite float (also in dicts and lists) replaced by ``None``."""
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_finite(x) for x in v]
+    if isinstance(v, float | np.floating) and not np.isfinite(v):
+        return None
+    return v
+
+
+def _plain(v):
+    if hasattr(v, "item"):
+        return v.item()
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    return str(v)
+
+
+def robot_from(args: argparse.Namespace):
+    """Load the robot named by ``--robot`` / ``--joint-map`` (or the positional ``robot``)."""
+    from imitwalk.robots import load_robot
+
+    return load_robot(args.robot, getattr(args, "joint_map", None))
+
+
+def _motion(args: argparse.Namespace):
+    from imitwalk.mocap import default_clip, load_motion
+
+    path = args.file or default_clip()
+    return load_motion(
+        path,
+        skeleton=args.skeleton,
+        units=getattr(args, "units", None),
+        up=getattr(args, "up", None),
+        joint_names=getattr(args, "joint_names", None),
+    )
+
+
+def retarget(args: argparse.Namespace) -> int:
+    from imitwalk.config import apply_overrides
+    from imitwalk.retarget import RetargetConfig
+    from imitwalk.retarget import retarget as run
+
+    robot = robot_from(args)
+    cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
+    cfg = _with_command(apply_overrides(cfg, args.set), args)
+    motion = _motion(args)
+    progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
+
+    _announce_search(cfg)
+    res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
+    progress(f"  cycles: {res.template.meta['cycles_report']}")
+    for row in res.reference.search.get("cadence", {}).get("trials", []):
+        progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
+    res.reference.settings["robot"] = _where(args.robot)
+    res.reference.settings["joint_map"] = _where(args.joint_map)
+    res.reference.save(args.out)
+    stats = res.stats()
+    stats["out"] = str(Path(args.out))
+    emit(stats, args.json)
+    return 0
+
+
+def _where(robot: str | None) -> str | None:
+    """A robot as a reference records it: a built-in name as it is, a file as an absolute
+    path (so that the reference plays from any working directory)."""
+    if robot is None or not Path(robot).is_file():
+        return robot
+    return str(Path(robot).resolve())
+
+
+def _announce_search(cfg) -> None:
+    """What a RetargetConfig's search does after its generations (progress lines)."""
+    sc = cfg.search_config
+    if cfg.search and sc.cadences:
+        rates = ", ".join(f"{r:g}" for r in sc.cadences)
+        n, secs = sc.cadence_models, sc.cadence_seconds
+        progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
+    if cfg.search and sc.refine_rounds:
+        at = "/".join(f"{x:g}" for x in sc.refine_scales)
+        r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
+        each = ", each scale on its own" if sc.refine_per_scale else ""
+        progress(f"  then up to {r} refinement rounds: {n} robots x {secs:g} s at {at}{each}")
+
+
+def search_report(gen: int, total: int, score: float, params: dict) -> None:
+    """Progress of the reference search (:mod:`imitwalk.retarget.search`)."""
+    shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
+    progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
+
+
+def refine_report(done: int, total: int, trial) -> None:
+    """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
+    what = (trial.changed or "searched") + ("" if trial.at is None else f" at {trial.at:g}")
+    mark = " (kept)" if trial.changed and trial.kept else ""
+    mark = mark if trial.complete else " (stopped: falls more than the set to beat)"
+    progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
+
+
+def playback(args: argparse.Namespace) -> int:
+    from imitwalk.retarget import Reference
+    from imitwalk.sim.playback import play_reference, summary
+
+    ref = Reference.load(args.reference)
+    if args.robot is None:
+        args.robot = ref.settings.get("robot", ref.robot)
+        args.joint_map = ref.settings.get("joint_map")
+    robot = robot_from(args)
+    seeds = list(range(args.models))
+    progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
+    runs = play_reference(
+        ref, robot, args.scale, args.seconds, seeds, workers=args.workers, engine=args.engine
+    )
+    out = {"scale": args.scale, "seconds": args.seconds, "engine": args.engine, **summary(runs)}
+    emit(out, args.json)
+    return 0
+
+
+def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
+    """``--set`` items for the retargeting (``retarget.``-prefixed) and for learning."""
+    rt = [i.split(".", 1)[1] for i in items if i.startswith("retarget.")]
+    return rt, [i for i in items if not i.startswith("retarget.")]
+
+
+def _with_command(cfg, args: argparse.Namespace):
+    """``cfg`` (a RetargetConfig) with the ``--turn/--side/--forward/--slope`` flags given."""
+    from dataclasses import replace
+
+    flags = {"turn_deg": "turn", "side_m": "side", "forward": "forward", "slope_deg": "slope"}
+    given = {k: getattr(args, a) for k, a in flags.items() if getattr(args, a, None) is not None}
+    return replace(cfg, command=replace(cfg.command, **given)) if given else cfg
+
+
+def learn(args: argparse.Namespace) -> int:
+    from imitwalk.config import apply_overrides
+    from imitwalk.errors import ConfigError
+    from imitwalk.retarget import Reference, RetargetConfig
+    from imitwalk.retarget import retarget as do_retarget
+    from imitwalk.runs import RunDir
+
+    robot = robot_from(args)
+    rt_set, learn_set = _split_settings(args.set)
+    if args.variant == "faithful":
+        from imitwalk.paper.learnconfig import preset
+        from imitwalk.paper.learner import learn as run
+
+        cfg = apply_overrides(preset("faithful", seed=args.seed), learn_set)
+    else:
+        from imitwalk.balance.tickconfig import TickLearnConfig
+        from imitwalk.balance.ticklearn import learn_tick as run
+
+        cfg = apply_overrides(TickLearnConfig(seed=args.seed), learn_set)
+    rd = RunDir(args.out)
+    rd.check_writable()
+    flags = [
+        f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
+    ]
+    resumed = args.resume and rd.exists("reference.npz")
+    given = args.reference or resumed
+    if flags and given:
+        raise ConfigError(
+            f"{', '.join(flags)} shape a new reference; a given or resumed reference keeps "
+            "the command it was built with (retarget again with them)"
+        )
+    rcfg = apply_overrides(RetargetConfig(), rt_set)  # checked even where it is not used
+    if rt_set and given:
+        unused = ", ".join(f"retarget.{i}" for i in rt_set)
+        progress(f"learn: {unused}: not used, the reference is given as it is")
+    if resumed:
+        ref = Reference.load(rd.file("reference.npz"))
+        progress(f"learn: resuming {rd.path}")
+    elif args.reference:
+        ref = Reference.load(args.reference)
+    else:
+        motion = _motion(args)
+        progress(f"learn: retargeting {motion.source}")
+        rcfg = _with_command(rcfg, args)
+        _announce_search(rcfg)
+        res = do_retarget(motion, robot, rcfg, search_report, refine_report)
+        progress(f"  cycles: {res.template.meta['cycles_report']}")
+        ref = res.reference
+        ref.settings["robot"] = _where(args.robot)
+        ref.settings["joint_map"] = _where(args.joint_map)
+    progress(f"learn: {args.variant} variant")
+    summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
+    out = {k: v for k, v in summary.items() if k not in ("config", "gait")}
+    out["variant"] = args.variant
+    out["run_dir"] = str(rd.path)
+    emit(out, args.json)
+    return 0
+
+
+def evaluate(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    cfg = rd.read_json("config.json")
+    if args.robot is None:
+        args.robot, args.joint_map = _run_robot(rd, cfg)
+    robot = robot_from(args)
+    if args.push_recovery:
+        return _push_recovery(args, rd, robot)
+    protocol = load_protocol(args.protocol)
+    if args.seeds < 1 or not args.seconds > 0:
+        raise ConfigError(
+            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
+        )
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    progress(
+        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
+        f"{args.seeds} robots x {args.seconds:g} s"
+    )
+    out = judge_protocol(
+        rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
+        scale=args.scale, workers=args.workers,
+    )  # fmt: skip
+    for name, side in out["controllers"].items():
+        lo, hi = side["survival_ci95"]
+        progress(
+            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
+            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+        )
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
+    emit(out, args.json)
+    return 0
+
+
+def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
+    """The robot a run learned on and its joint map: the file its reference records (a
+    built-in name, or the joint map's path), else the name in its ``config.json``."""
+    from imitwalk.retarget import Reference
+
+    settings = (
+        Reference.load(rd.file("reference.npz")).settings if rd.exists("reference.npz") else {}
+    )
+    name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
+    return name or "hoap2", settings.get("joint_map")
+
+
+def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
+    from imitwalk.judge.pushes import push_recovery
+
+    progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    out = push_recovery(rd.path, robot, controllers=chosen, scale=args.scale, workers=args.workers)
+    for name, side in out["controllers"].items():
+        least = side["min_by_direction"].items()
+        progress(
+            f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
+        )
+    rd.write_json("push_recovery.json", out)
+    emit(out, args.json)
+    return 0
+
+
+def demo(args: argparse.Namespace) -> int:
+    from imitwalk.cli.demo import run_demo
+
+    emit(run_demo(Path(args.out)), args.json)
+    return 0
+
+
+def report(args: argparse.Namespace) -> int:
+    from imitwalk.evidence.report import write_report
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    rd.read_json("metrics.json")  # a clear error if this is not a finished run
+    robot = None
+    if args.robot:
+        robot = robot_from(args)
+    path = write_report(rd.path, robot, seconds=args.seconds, progress=progress)
+    emit({"report": str(path)}, args.json)
+    return 0

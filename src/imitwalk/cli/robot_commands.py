@@ -1,0 +1,92 @@
+"""The ``imitwalk robot`` subcommands: ``info``, ``stand`` and ``import``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from imitwalk.cli.commands import emit, progress, robot_from
+
+__all__ = ["robot_import", "robot_info", "robot_stand"]
+
+
+def robot_info(args: argparse.Namespace) -> int:
+    from imitwalk.sim.mujoco import SimOptions
+
+    r = robot_from(args)
+    opt = SimOptions()
+    joints = {
+        n: {
+            "mjcf": j,
+            "min_rad": float(lo),
+            "max_rad": float(hi),
+            "kp_nm_per_rad": float(kp),
+            "torque_limit_nm": float(tl),
+        }
+        for n, j, (lo, hi), kp, tl in zip(
+            r.joint_names, r.mj_joints, r.limits, r.kp, r.torque_limit, strict=True
+        )
+    }
+    emit(
+        {
+            "name": r.name,
+            "mjcf": str(r.mjcf),
+            "dof": r.dof,
+            "joints": joints,
+            "total_mass_kg": r.total_mass,
+            "standing_height_m": r.height,
+            "standing_torso_height_m": r.torso_height,
+            "sensors": {
+                "gyro": r.gyro,
+                "accelerometer": r.accelerometer,
+                "foot_force": {s: list(v) for s, v in r.foot_force.items()},
+                "all": list(r.sensors),
+            },
+            "control_hz": opt.control_hz,
+            "physics_hz": opt.physics_hz,
+        },
+        args.json,
+        finite=True,
+    )
+    return 0
+
+
+def robot_stand(args: argparse.Namespace) -> int:
+    from imitwalk.errors import RobotError
+    from imitwalk.sim.standing import stand_test
+
+    robot = robot_from(args)
+    res = stand_test(robot, seconds=args.seconds)
+    if res.fell:
+        raise RobotError(res.refusal(robot.name))
+    emit(res.to_dict(), args.json, finite=True)
+    return 0
+
+
+def robot_import(args: argparse.Namespace) -> int:
+    from imitwalk.errors import RobotError
+    from imitwalk.fileio import atomic_write
+    from imitwalk.robots.draft import draft_joint_map
+
+    out, mjcf = Path(args.out), Path(args.mjcf)
+    if out.is_dir():
+        raise RobotError(f"--out {out} is a folder; give the joint map's file name")
+    if out.exists() and mjcf.exists() and out.resolve() == mjcf.resolve():
+        raise RobotError(f"--out {out} is the MJCF file itself; imitwalk never edits it")
+    draft = draft_joint_map(mjcf, out)
+    for line in draft.lines:
+        progress(f"  {line}")
+    atomic_write(out, lambda tmp: tmp.write_text(json.dumps(draft.jmap, indent=2) + "\n"))
+    r = draft.robot
+    summary = {
+        "out": str(out),
+        "name": r.name,
+        "dof": r.dof,
+        "roles": list(r.joint_names),
+        "total_mass_kg": r.total_mass,
+        "standing_height_m": r.height,
+        "stand": draft.stand.to_dict(),
+    }
+    emit(summary, args.json, finite=True)
+    return 0

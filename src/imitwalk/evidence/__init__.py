@@ -1,0 +1,1 @@
+"""Evidence of a run: plots, learning curves, film strips and video, and the HTML report."""

@@ -1,0 +1,112 @@
+"""A finished run, loaded to replay: its reference and every controller it can build.
+
+:func:`load_run` reads a run folder of either learner: the per-tick balance learner
+(:mod:`imitwalk.balance.ticklearn`, the default) or the paper's as written (``faithful``,
+:mod:`imitwalk.paper.learner`). Both give a :class:`LoadedRun`: the reference, the scale the
+run reached, the engine it learned on, and :meth:`~LoadedRun.policy`, a fresh
+controller by name. ``open_loop`` (the reference played as it is) is every run's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.retarget.reference import Reference
+from imitwalk.runs import RunDir
+
+__all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
+
+#: The controller every run can build: its reference played as it is.
+OPEN_LOOP = "open_loop"
+
+
+class _OpenLoop:
+    """The reference's trajectory as a policy, starting where it starts."""
+
+    def __init__(self, ref: Reference, scale: float, seconds: float):
+        self.q = ref.trajectory(scale, seconds)
+        self.q0 = self.q[0]
+
+    def __call__(self, k: int, _obs):
+        return self.q[min(k, len(self.q) - 1)]
+
+
+@dataclass(frozen=True)
+class LoadedRun:
+    """A finished run.
+
+    Attributes:
+        path: its folder; learner: ``"tick"`` or ``"faithful"``; ref: its reference;
+        scale: the scale it reached; engine: the engine it learned on; metrics: its
+        ``metrics.json``; laws: the per-tick run's feedback laws by controller name;
+        gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`).
+    """
+
+    path: str
+    learner: str
+    ref: Reference
+    scale: float
+    engine: str
+    metrics: dict
+    laws: dict | None = None
+    gait: object | None = None
+
+    def controllers(self) -> tuple[str, ...]:
+        """The controllers it can build, ``open_loop`` last."""
+        names = tuple(self.laws) if self.laws is not None else ("learned",)
+        return (*names, OPEN_LOOP)
+
+    def twin(self, controller: str) -> str:
+        """The first controller that is ``controller``'s exact copy (itself if none is):
+        a run whose model-based law was not kept has ``learned`` equal to ``feedback``,
+        and a judge walks such a pair once."""
+        if self.laws is None or controller == OPEN_LOOP:
+            return controller
+        mine = [law.to_arrays("") for law in self.laws[controller]]
+        for other in self.controllers():
+            theirs = [law.to_arrays("") for law in self.laws.get(other, ())]
+            if len(theirs) == len(mine) and all(
+                a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+                for a, b in zip(mine, theirs, strict=True)
+            ):
+                return other
+        return controller
+
+    def policy(self, controller: str, robot, scale: float | None = None, seconds: float = 30.0):
+        """A fresh controller ``controller`` (no exploration) at ``scale`` (default: the
+        scale reached) for a walk of ``seconds`` [s].
+
+        Raises:
+            ConfigError: a controller this run cannot build (listing the ones it can).
+        """
+        scale = self.scale if scale is None else scale
+        if controller == OPEN_LOOP:
+            return _OpenLoop(self.ref, scale, seconds)
+        if controller not in self.controllers():
+            raise unknown_name("controller", controller, self.controllers(), ConfigError)
+        if self.laws is not None:
+            from imitwalk.balance.feedback import TickPolicy
+
+            return TickPolicy(self.ref, scale, self.laws[controller], robot.joint_names, seconds)
+        return self.gait.policy(scale)
+
+
+def load_run(run_dir) -> LoadedRun:
+    """Read a finished run folder (a one-line :class:`~imitwalk.errors.RunError` if it is
+    not one)."""
+    rd = RunDir(run_dir)
+    config, metrics = rd.read_json("config.json"), rd.read_json("metrics.json")
+    engine = str(config.get("learn", {}).get("engine", "mujoco"))
+    if config.get("learner") == "tick":
+        from imitwalk.balance.tickstore import load_laws
+
+        ref = Reference.load(rd.file("reference.npz"))
+        scale = float(metrics["scale_reached"])
+        return LoadedRun(str(rd.path), "tick", ref, scale, engine, metrics, laws=load_laws(rd.path))
+    from imitwalk.paper.evaluate import load_gait
+
+    lg = load_gait(rd.path)
+    return LoadedRun(str(rd.path), "faithful", lg.ref, lg.scale, engine, metrics, gait=lg)
