@@ -222,7 +222,8 @@ def kick_strip(renderer, run_, robot: Robot, count: int):
     seconds = t + 1.5
     opts = ref.sim_options(SimOptions(pushes=(dv,)))
     policy = run_.policy("learned", robot, run_.scale, seconds)
-    ro = run(make_plant(robot, opts, run_.engine), policy, round(seconds / ref.dt), False)
+    steps = round(seconds / ref.dt)
+    ro = run(make_plant(robot, opts, run_.engine), policy, steps, stop_on_fall=False)
     idx = np.linspace(round(t / ref.dt), len(ro.qpos) - 1, count).astype(int)
     images = [renderer.frame(ro.qpos[i]) for i in idx]
     titles = [f"t = {ro.t[i]:.2f} s" for i in idx]
