@@ -103,3 +103,33 @@ class RunDir:
             raise RunError(f"{p} not found")
         with np.load(p, allow_pickle=False) as z:
             return {k: z[k] for k in z.files}
+
+    def start(self, config_json: dict, reference, resume: bool, settings=None):
+        """Open a learning run: a fresh folder (``config.json`` and ``reference.npz``
+        written) or, with ``resume``, the interrupted one, which must have been started
+        with the same ``config_json["learn"]`` (compared after ``settings``, a function
+        that reads the saved ones back into their canonical form).
+
+        Returns:
+            the saved ``checkpoint.json`` and log when resuming, else ``(None, [])``.
+
+        Raises:
+            RunError: nothing to resume, other settings, or a folder that holds a run.
+        """
+        if resume:
+            if not self.exists("checkpoint.json"):
+                raise RunError(f"nothing to resume in {self.path}: no checkpoint.json")
+            saved = self.read_json("config.json")["learn"]
+            if (settings(saved) if settings else saved) != config_json["learn"]:
+                raise RunError(
+                    f"{self.path} was started with other settings; resume with the same ones"
+                )
+            return self.read_json("checkpoint.json"), self.read_log()
+        if self.exists("checkpoint.json"):
+            raise RunError(
+                f"{self.path} already holds a run; pass --resume or choose another --out"
+            )
+        self.path.mkdir(parents=True, exist_ok=True)
+        self.write_json("config.json", config_json)
+        reference.save(self.file("reference.npz"))
+        return None, []

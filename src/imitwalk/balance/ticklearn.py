@@ -45,7 +45,6 @@ from imitwalk.balance.tickstore import (
     unstack_episodes,
 )
 from imitwalk.config import to_dict
-from imitwalk.errors import RunError
 from imitwalk.judge.protocol import load_protocol
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
@@ -269,21 +268,9 @@ def learn_tick(
     rd = RunDir(run_dir)
     cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
                 "learner": "tick"}  # fmt: skip
-    if resume:
-        if not rd.exists("checkpoint.json"):
-            raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
-        if rd.read_json("config.json")["learn"] != cfg_json["learn"]:
-            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
-        state = TickProgress(**rd.read_json("checkpoint.json"))
-        log = rd.read_log()
-        data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
-    else:
-        if rd.exists("checkpoint.json"):
-            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
-        rd.path.mkdir(parents=True, exist_ok=True)
-        rd.write_json("config.json", cfg_json)
-        ref.save(rd.file("reference.npz"))
-        state, log, data = TickProgress(), [], []
+    saved, log = rd.start(cfg_json, ref, resume)
+    state = TickProgress(**saved) if saved else TickProgress()
+    data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []
     lr = _Learner(ref, robot, config, rd, progress)
     if state.stage == "trials":
         _trials(lr, state, log)

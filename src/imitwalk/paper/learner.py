@@ -17,7 +17,6 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from imitwalk.config import from_dict, to_dict
-from imitwalk.errors import RunError
 from imitwalk.paper.episode import EpisodeJob, run_episode
 from imitwalk.paper.gait import GaitModel
 from imitwalk.paper.learnconfig import LearnConfig
@@ -89,22 +88,10 @@ def learn(
     rd = RunDir(run_dir)
     cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
                 "learner": "faithful"}  # fmt: skip
-    if resume:
-        if not rd.exists("checkpoint.json"):
-            raise RunError(f"nothing to resume in {rd.path}: no checkpoint.json")
-        saved = from_dict(LearnConfig, rd.read_json("config.json")["learn"])
-        if to_dict(saved) != cfg_json["learn"]:
-            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
-        state = FaithfulProgress(**rd.read_json("checkpoint.json"))
-        log = rd.read_log()
-        data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
-    else:
-        if rd.exists("checkpoint.json"):
-            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
-        rd.path.mkdir(parents=True, exist_ok=True)
-        rd.write_json("config.json", cfg_json)
-        ref.save(rd.file("reference.npz"))
-        state, log, data = FaithfulProgress(), [], []
+    canonical = lambda learn: to_dict(from_dict(LearnConfig, learn))  # noqa: E731
+    saved, log = rd.start(cfg_json, ref, resume, canonical)
+    state = FaithfulProgress(**saved) if saved else FaithfulProgress()
+    data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []
     sch = config.schedule
     scales = sch.scales()
     gait = GaitModel(ref, scales, config.gait)
