@@ -76,6 +76,13 @@ def apply_overrides(cfg: Any, overrides: list[str] | tuple[str, ...] | None) -> 
     return cfg
 
 
+def schedule_scales(start: float, step: float, stop: float) -> tuple[float, ...]:
+    """The scales of a schedule from ``start`` up to ``stop`` in ``step`` s (§6), the last
+    one never past ``stop``."""
+    n = max(int(round((stop - start) / step)) + 1, 1)
+    return tuple(round(min(start + i * step, stop), 6) for i in range(n))
+
+
 def to_dict(cfg: Any) -> dict:
     """Plain-JSON dictionary of a (nested) settings dataclass."""
     return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))

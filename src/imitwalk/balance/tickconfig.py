@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from imitwalk.balance.channels import CHANNELS, FEATURES, PHASED, check_names
+from imitwalk.config import schedule_scales
 from imitwalk.errors import ConfigError
 from imitwalk.judge.protocol import load_protocol
 from imitwalk.sim.types import ENGINES
@@ -170,5 +171,4 @@ class TickLearnConfig:
 
     def scales(self) -> tuple[float, ...]:
         """The schedule's scales."""
-        n = int(round((self.stop - self.start) / self.step)) + 1
-        return tuple(round(min(self.start + i * self.step, self.stop), 6) for i in range(n))
+        return schedule_scales(self.start, self.step, self.stop)

@@ -62,10 +62,6 @@ class TickResult:
     cost: float
     episode: Episode | None = None
 
-    def score(self) -> tuple[float, float]:
-        """How a trial ranks it: a fall first (and sooner is worse), then the cost."""
-        return (float(self.fell), self.cost)
-
 
 _REFS: dict = {}
 

@@ -13,7 +13,6 @@ from imitwalk.cli.progress import progress
 __all__ = [
     "emit",
     "playback",
-    "progress",
     "retarget",
     "robot_from",
 ]

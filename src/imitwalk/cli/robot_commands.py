@@ -6,7 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
-from imitwalk.cli.commands import emit, progress, robot_from
+from imitwalk.cli.commands import emit, robot_from
+from imitwalk.cli.progress import progress
 
 __all__ = ["robot_import", "robot_info", "robot_stand"]
 

@@ -134,6 +134,7 @@ def judge_protocol(
         if c not in valid:
             raise unknown_name("controller", c, valid, ConfigError)
     draws = [protocol.draw(s, robot, seconds=seconds) for s in range(seeds)]
+    twin = {c: loaded.twin(c) for c in controllers}
     jobs = [
         JudgeJob(
             str(run_dir),
@@ -146,12 +147,12 @@ def judge_protocol(
             scale,
             protocol.engine,
         )
-        for c in dict.fromkeys(loaded.twin(c) for c in controllers)  # exact copies walk once
+        for c in dict.fromkeys(twin.values())  # exact copies walk once
         for d in draws
     ]
     res = run_parallel(run_controller, jobs, workers)
     by = {
-        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == loaded.twin(c)]
+        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
         for c in controllers
     }
     out = {

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
+from imitwalk.config import schedule_scales
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.paper.gait import GaitConfig
 from imitwalk.sim.types import ENGINES
@@ -39,8 +40,7 @@ class ScheduleConfig:
 
     def scales(self) -> tuple[float, ...]:
         """The schedule's scales."""
-        n = int(round((self.stop - self.start) / self.step)) + 1
-        return tuple(round(self.start + i * self.step, 6) for i in range(max(n, 1)))
+        return schedule_scales(self.start, self.step, self.stop)
 
 
 @dataclass(frozen=True)
