@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
-from unittest.mock import ANY
 
 import numpy as np
 import pytest
 
-from imitwalk.errors import ConfigError
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import GaitParams, Reference, RetargetConfig, extract_template, retarget
 from imitwalk.retarget.ik import leg_geometry
@@ -167,44 +165,3 @@ def test_mid_swing_is_found_in_every_swing_whatever_the_sampling():
     sigma[37:, 0] = [0.1, 0.2, 0.3]
     ticks = _mid_swing_ticks(stance, sigma)
     assert sorted(ticks) == [(6, 0), (26, 1), (39, 0)]
-
-
-def test_cadence_search_plays_each_rate_on_the_same_robots_and_keeps_the_fewest_falls(robot, built):
-    from imitwalk.retarget.search import search_cadence
-
-    ref = built.reference
-    cfg = SearchConfig(
-        scales=(0.5, 1.0), cadences=(1.0, 1.1), cadence_models=2, cadence_seconds=2.0, workers=1
-    )
-    rate, rep = search_cadence(ref, robot, cfg)
-    assert [r["rate"] for r in rep["trials"]] == [1.0, 1.1]
-    assert rep["scale"] == 1.0 and rep["seeds"] == [0, *rep["seeds"][1:]]
-    assert all(r["robots"] == 2 for r in rep["trials"])
-    fewest = min(r["falls"] for r in rep["trials"])
-    tied = [r["rate"] for r in rep["trials"] if r["falls"] == fewest]
-    assert rate == min(tied, key=lambda r: abs(r - 1.0))  # a tie keeps the human's cadence
-    assert search_cadence(ref, robot, cfg) == (rate, {**rep, "wall_seconds": ANY})
-
-
-def test_cadence_search_settings_are_checked(robot):
-    with pytest.raises(ConfigError, match=r"0\.5\.\.2"):
-        SearchConfig(cadences=(3.0,))
-    with pytest.raises(ConfigError, match="cadence_models"):
-        SearchConfig(cadences=(1.0,), cadence_models=0)
-    cfg = RetargetConfig(cadence=1.1, search_config=SearchConfig(cadences=(1.0, 1.1)))
-    with pytest.raises(ConfigError, match=r"either cadence or search_config\.cadences"):
-        retarget(load_motion(default_clip()), robot, cfg)
-
-
-def test_retarget_applies_the_searched_cadence_and_reports_it(robot):
-    sc = SearchConfig(
-        generations=1, population=2, elites=1, scales=(0.4,), models=1, seconds=1.5,
-        workers=1, cadences=(1.0, 1.25), cadence_models=1, cadence_seconds=1.0,
-    )  # fmt: skip
-    res = retarget(
-        load_motion(default_clip()), robot, RetargetConfig(scales=(0.3, 0.4), search_config=sc)
-    )
-    picked = res.reference.search["cadence"]["rate"]
-    assert picked == 1.0  # no fall in 1 s at either rate: the tie keeps the human's cadence
-    assert res.stats()["cadence_search"]["trials"][1]["rate"] == 1.25
-    assert res.reference.settings.get("cadence", 1.0) == 1.0

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from imitwalk.cli.main import main
-from imitwalk.errors import ImitwalkError
 from imitwalk.robots import load_robot
 from imitwalk.sim.metrics import tilt_deg
 from imitwalk.sim.mujoco import MujocoPlant, Plant, SimOptions, make_plant, playback
@@ -140,21 +139,6 @@ def test_friction_and_mass_and_kp_options(robot):
     ratio = p.model.actuator_gainprm[:, 0] / base.actuator_gainprm[:, 0]
     assert ratio.min() >= 0.81 - 1e-9 and ratio.max() <= 0.99 + 1e-9 and ratio.std() > 0
     assert np.allclose(p.model.actuator_biasprm[:, 1], -p.model.actuator_gainprm[:, 0])
-
-
-def test_kp_jitter_on_named_joints_only(robot):
-    """The jitter's draws do not depend on which joints take them."""
-    base = MujocoPlant(robot).model.actuator_gainprm[:, 0]
-    full = MujocoPlant(robot, SimOptions(kp_jitter=0.1, seed=3)).model.actuator_gainprm[:, 0]
-    knees = ("l_knee", "r_knee")
-    opt = SimOptions(kp_jitter=0.1, seed=3, kp_jitter_joints=knees)
-    p = MujocoPlant(robot, opt)
-    part = p.model.actuator_gainprm[:, 0]
-    on = np.isin(np.arange(len(part)), [p._act[robot.joint_names.index(j)] for j in knees])
-    assert np.allclose(part[on], full[on]) and not np.allclose(part[on], base[on])
-    assert np.allclose(part[~on], base[~on])
-    with pytest.raises(ImitwalkError, match=r"unknown joint 'kneee'.*l_knee"):
-        MujocoPlant(robot, SimOptions(kp_jitter=0.1, kp_jitter_joints=("kneee",)))
 
 
 def test_heavier_robot_presses_harder(robot):

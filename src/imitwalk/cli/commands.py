@@ -88,8 +88,6 @@ def retarget(args: argparse.Namespace) -> int:
     _announce_search(cfg)
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
     progress(f"  cycles: {res.template.meta['cycles_report']}")
-    for row in res.reference.search.get("cadence", {}).get("trials", []):
-        progress(f"  cadence {row['rate']:g}: {row['falls']}/{row['robots']} fell")
     res.reference.settings["robot"] = _where(args.robot)
     res.reference.settings["joint_map"] = _where(args.joint_map)
     res.reference.save(args.out)
@@ -110,10 +108,6 @@ def _where(robot: str | None) -> str | None:
 def _announce_search(cfg) -> None:
     """What a RetargetConfig's search does after its generations (progress lines)."""
     sc = cfg.search_config
-    if cfg.search and sc.cadences:
-        rates = ", ".join(f"{r:g}" for r in sc.cadences)
-        n, secs = sc.cadence_models, sc.cadence_seconds
-        progress(f"  then cadence trials: {rates} on {n} robots x {secs:g} s")
     if cfg.search and sc.refine_rounds:
         at = "/".join(f"{x:g}" for x in sc.refine_scales)
         r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds

@@ -7,8 +7,7 @@ strides and postures, cycles a whole number of ticks shorter. The start-up from 
 keeps the human's cadence (played faster, it tips the robot over within three seconds),
 and its last tick still flows into the loop's first; the balance channels then start
 their step clock at the loop (:class:`imitwalk.paper.policy.WalkPolicy`).
-``imitwalk retarget --set cadence=R`` writes such a reference, and the learner's trials
-(``LearnConfig.cadences``, :mod:`imitwalk.trust`) can pick the rate.
+``imitwalk retarget --set cadence=R`` writes such a reference.
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.refine import refine_params, refine_per_scale
-from imitwalk.retarget.search import SearchConfig, search_cadence, search_params
+from imitwalk.retarget.search import SearchConfig, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
 from imitwalk.retarget.walkable import build_walkable, off_grid
 from imitwalk.robots import Robot
@@ -53,8 +53,7 @@ class RetargetConfig:
             (:class:`~imitwalk.retarget.command.GaitCommand`; default straight, level).
         cadence: play the loop this many times as fast as the human walked
             (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
-            the human's cadence). 1: the human's own. To have it searched instead, give
-            ``search_config.cadences`` (:func:`~imitwalk.retarget.search.search_cadence`).
+            the human's cadence). 1: the human's own.
     """
 
     CHOICES: ClassVar[dict] = {"mapping": MAPPINGS}
@@ -117,8 +116,6 @@ class RetargetResult:
             out["refine"] = {k: r[k] for k in keys}
             out["refine"]["runs_per_trial"] = r["trials"][0]["robots"]
             out["refine"]["trials"] = len(r["trials"])
-        if "cadence" in ref.search:
-            out["cadence_search"] = ref.search["cadence"]
         return out
 
 
@@ -154,9 +151,6 @@ def retarget(
     t0 = time.perf_counter()
     if cfg.mapping == "paper" and not cfg.command.straight:
         raise ConfigError("a turn, sidestep, stride fraction or slope needs mapping=walkable")
-    searched_cadence = cfg.search and cfg.mapping == "walkable" and bool(cfg.search_config.cadences)
-    if searched_cadence and cfg.cadence != 1.0:
-        raise ConfigError("give either cadence or search_config.cadences, not both")
     if cfg.mapping == "paper":
         ref = build_paper(motion, template, robot, cfg.scales, dt)
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
@@ -207,8 +201,5 @@ def retarget(
         "motion_fps": motion.fps,
         "filled": list(motion.filled),
     }
-    rate = cfg.cadence
-    if searched_cadence:
-        rate, ref.search["cadence"] = search_cadence(ref, robot, cfg.search_config)
-    ref = with_cadence(ref, rate)
+    ref = with_cadence(ref, cfg.cadence)
     return RetargetResult(ref, motion.n_frames, motion.fps, template, frames, seconds)

@@ -6,11 +6,6 @@ double support, lean, width) are chosen by the cross-entropy method over open-lo
 rollouts: each candidate reference is solved by IK at a few stride scales and played
 on the nominal robot and on training perturbations (never an evaluation robot). A
 rollout scores ``alive fraction + ½·min(progress ratio, 1) − ½·min(|yaw drift| / 45°, 1)``.
-
-The cadence can be searched too (``SearchConfig.cadences``, off by default):
-:func:`search_cadence` plays the searched reference at full stride at each candidate rate
-(:func:`~imitwalk.retarget.cadence.with_cadence`) on more training robots, for longer, and
-keeps the rate with the fewest falls.
 """
 
 from __future__ import annotations
@@ -22,12 +17,10 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.parallel import run_parallel
-from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.params import leg_scaled
 from imitwalk.retarget.plan import GaitParams
-from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
@@ -36,7 +29,7 @@ from imitwalk.sim.mujoco import SimOptions, make_plant, playback
 from imitwalk.sim.perturb import perturbed, train_seeds
 from imitwalk.sim.types import ENGINES
 
-__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "bounds", "search_cadence", "search_params"]
+__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "bounds", "search_params"]
 
 #: Search range of each reference parameter; the ranges of the lengths (:data:`LENGTHS`)
 #: are for a leg of :data:`~imitwalk.retarget.params.REFERENCE_LEG` (:func:`bounds`).
@@ -73,17 +66,11 @@ class SearchConfig:
         seconds: simulated time per rollout [s]; seed: the search's random seed.
         workers: parallel processes (``None``: one per core).
         engine: the physics engine of the trials (:data:`imitwalk.sim.types.ENGINES`).
-        cadences: candidate cadence rates (0.5–2; 1: the human's) for
-            :func:`search_cadence`, tried after the parameters; empty: not searched.
-        cadence_models, cadence_seconds: robots (the nominal one + training
-            perturbations, with the evaluation's initial push) and simulated time [s] per
-            cadence trial, at the largest of ``scales``.
         refine_rounds: rounds of :func:`~imitwalk.retarget.refine.refine_params` after
             the search (0: off); refine_scales: the stride scales it counts falls at;
-            refine_models, refine_seconds: its robots (as for the cadence) and simulated
-            time per robot [s], at each of ``refine_scales``; refine_yaw_slack: if set, a
-            nudge is kept only if its mean |heading drift| is at most this much [deg] above
-            the searched reference's (``None``: heading not guarded); refine_per_scale:
+            refine_models, refine_seconds: its robots (the nominal one + training
+            perturbations, with the evaluation's initial push) and simulated
+            time per robot [s], at each of ``refine_scales``; refine_per_scale:
             refine each of ``refine_scales`` on its own, judged there alone, and solve
             the reference with each one's set at that scale
             (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales);
@@ -100,33 +87,20 @@ class SearchConfig:
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"
-    cadences: tuple[float, ...] = ()
-    cadence_models: int = 24
-    cadence_seconds: float = 20.0
     refine_rounds: int = 0
     refine_scales: tuple[float, ...] = (0.8, 0.9, 1.0)
     refine_models: int = 24
     refine_seconds: float = 30.0
-    refine_yaw_slack: float | None = None
     refine_per_scale: bool = False
     refine_early_stop: bool = True
 
     def __post_init__(self):
         if self.engine not in ENGINES:
             raise unknown_name("engine", self.engine, ENGINES, ConfigError)
-        for r in self.cadences:
-            if not 0.5 <= r <= 2.0:
-                raise ConfigError(f"search_config.cadences: {r} is not a rate in 0.5..2")
-        if self.cadences and (self.cadence_models < 1 or self.cadence_seconds <= 0):
-            raise ConfigError("search_config.cadence_models must be >= 1 and cadence_seconds > 0")
         if self.refine_rounds < 0:
             raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
         if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
             raise ConfigError("search_config.refine_models must be >= 1 and refine_seconds > 0")
-        if self.refine_yaw_slack is not None and not self.refine_yaw_slack >= 0:
-            raise ConfigError(
-                f"search_config.refine_yaw_slack: {self.refine_yaw_slack} is not >= 0 degrees"
-            )
         if self.refine_rounds and not all(0.0 < x <= 1.0 for x in self.refine_scales or [0]):
             raise ConfigError(
                 f"search_config.refine_scales: {self.refine_scales} must be scales in (0, 1]"
@@ -231,58 +205,3 @@ def search_params(
         "history": history,
     }
     return GaitParams(**best["params"]), report
-
-
-def search_cadence(
-    ref: Reference, robot: Robot, config: SearchConfig, base: SimOptions | None = None
-) -> tuple[float, dict]:
-    """Pick the rate of ``config.cadences`` at which ``ref`` falls least, open loop.
-
-    Each rate is played at the largest search scale on ``config.cadence_models`` training
-    robots (the same robots for every rate) for ``config.cadence_seconds``. The fewest
-    falls wins; a tie goes to the rate nearest the human's (1), then to the smaller mean
-    |yaw drift|.
-
-    Returns:
-        the rate (relative to ``ref``'s cadence) and a JSON-able report of every trial.
-    """
-    from imitwalk.sim.playback import play_reference  # it imports this package
-
-    scale = max(config.scales)
-    seeds = train_seeds(config.cadence_models)
-    t0 = time.perf_counter()
-    rows = []
-    for rate in config.cadences:
-        runs = [
-            r.metrics
-            for r in play_reference(
-                with_cadence(ref, rate),
-                robot,
-                scale,
-                config.cadence_seconds,
-                seeds,
-                base,
-                config.workers,
-                config.engine,
-                disturbance=True,
-            )
-        ]
-        rows.append(
-            {
-                "rate": float(rate),
-                "falls": int(sum(m.fell for m in runs)),
-                "robots": len(runs),
-                "mean_abs_yaw_deg": float(np.mean([abs(m.yaw_drift_deg) for m in runs])),
-                "mean_progress_ratio": float(np.mean([m.progress_ratio for m in runs])),
-            }
-        )
-    best = min(rows, key=lambda r: (r["falls"], abs(r["rate"] - 1.0), r["mean_abs_yaw_deg"]))
-    report = {
-        "scale": scale,
-        "seconds": config.cadence_seconds,
-        "seeds": list(seeds),
-        "trials": rows,
-        "rate": best["rate"],
-        "wall_seconds": time.perf_counter() - t0,
-    }
-    return best["rate"], report

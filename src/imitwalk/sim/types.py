@@ -41,8 +41,6 @@ class SimOptions:
         mass_scale: multiplies every body mass and inertia.
         mass_jitter: each body's mass also scaled by U(1 - j, 1 + j) (drawn from ``seed``).
         kp_scale: multiplies every servo stiffness; kp_jitter: per servo U(1 - j, 1 + j).
-        kp_jitter_joints: if set, only these joints' servos take their jitter (the draws
-            are the same, so the other joints are as with no jitter at all).
         slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
         com_shift: ``(3,)`` the torso's centre of mass moved by this much in its own frame [m].
         pushes: velocity kicks ``(t [s], Δv_x, Δv_y [m/s])``, in time order: at the first
@@ -66,7 +64,6 @@ class SimOptions:
     mass_jitter: float = 0.0
     kp_scale: float = 1.0
     kp_jitter: float = 0.0
-    kp_jitter_joints: tuple[str, ...] = ()
     slope_deg: float = 0.0
     com_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
     pushes: tuple[tuple[float, float, float], ...] = ()
@@ -140,22 +137,12 @@ def jitter_draws(
     Returns:
         ``(nbody,)`` mass (and inertia) factors, the world's (body 0) 1; ``(n,)`` servo
         stiffness factors, in the order of ``joint_names``.
-
-    Raises:
-        RobotError: a name in ``options.kp_jitter_joints`` that is not a joint.
     """
-    from imitwalk.errors import unknown_name
-
     opt = options
     rng = np.random.default_rng(opt.seed)
     mass = opt.mass_scale * rng.uniform(1 - opt.mass_jitter, 1 + opt.mass_jitter, nbody)
     mass[0] = 1.0
     kp = rng.uniform(1 - opt.kp_jitter, 1 + opt.kp_jitter, len(joint_names))
-    if opt.kp_jitter_joints:
-        for j in opt.kp_jitter_joints:
-            if j not in joint_names:
-                raise unknown_name("joint", j, joint_names)
-        kp[[j not in opt.kp_jitter_joints for j in joint_names]] = 1.0
     return mass, opt.kp_scale * kp
 
 
