@@ -45,9 +45,11 @@ def sets(settings: list[str]) -> list[str]:
     return [a for s in settings for a in ("--set", s)]
 
 
-def strip_wall(summary: dict) -> dict:
-    """A learning summary without its wall time (the one thing a rerun may change)."""
-    return {k: v for k, v in summary.items() if k != "wall_seconds_for_learning"}
+def strip_wall(summary) -> dict:
+    """A learning summary (a :class:`~imitwalk.runs.LearnSummary` or its ``metrics.json``)
+    without its wall time (the one thing a rerun may change)."""
+    d = summary if isinstance(summary, dict) else summary.to_dict()
+    return {k: v for k, v in d.items() if k != "wall_seconds_for_learning"}
 
 
 def strip_log(log: list[dict]) -> list[dict]:

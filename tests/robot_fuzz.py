@@ -154,7 +154,7 @@ def _finite_robot(robot) -> str | None:
     """What is wrong with an accepted robot (``None``: nothing)."""
     import numpy as np
 
-    from imitwalk.cli.commands import _finite
+    from imitwalk.cli.progress import _finite
 
     for name in ("signs", "stand", "stand_qpos", "limits", "kp"):
         if not np.isfinite(getattr(robot, name)).all():

@@ -283,14 +283,14 @@ def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     ref = build_walkable(template, robot, GaitParams(), [0.3, 0.4], 0.01, command=cmd).reference
     cfg = apply_overrides(TickLearnConfig(), [*TICK, "start=0.3", "step=0.1", "stop=0.4"])
     summary = learn_tick(ref, robot, cfg, tmp_path / "run")
-    assert summary["scale_reached"] is not None
+    assert summary.scale_reached is not None
     protocol = load_protocol("eval")
     for mode in ("learned", "feedback", "open_loop"):
         for seed in (0, 1):
             d = protocol.draw(seed, robot, seconds=10.0)
             job = JudgeJob(str(tmp_path / "run"), robot, mode, seed, d.options, d.furthest,
                            10.0, None, protocol.engine)  # fmt: skip
-            r = run_controller(job)
-            assert r["commanded_turn_deg"] > 20.0  # ~4.8° per cycle for 10 s
-            if not r["fell"]:  # it follows the turn: what is left is a drift, not the turn
-                assert abs(r["yaw_drift_deg"]) < r["commanded_turn_deg"] / 2
+            r = run_controller(job).metrics
+            assert r.commanded_turn_deg > 20.0  # ~4.8° per cycle for 10 s
+            if not r.fell:  # it follows the turn: what is left is a drift, not the turn
+                assert abs(r.yaw_drift_deg) < r.commanded_turn_deg / 2

@@ -21,6 +21,8 @@ NUMPY_ONLY = (
     "evidence.plots",
     "fileio",
     "judge",
+    "judge.protocolcheck",
+    "judge.records",
     "judge.tables",
     "paper",
     "paper.controller",

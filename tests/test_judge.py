@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from imitwalk.errors import ConfigError
 from imitwalk.judge.protocol import load_protocol
+from imitwalk.judge.records import ProtocolVerdict
 from imitwalk.judge.verdict import judge_protocol
 from imitwalk.paper.evaluate import compare_falls
 
@@ -19,67 +22,75 @@ def judged(tick_run, robot):
 
 
 def test_every_controller_walks_the_same_robots(judged, robot):
-    sides = judged["controllers"]
+    sides = judged.controllers
     assert list(sides) == ["learned", "feedback", "fixed", "open_loop"]
     protocol = load_protocol("hard")
     furthest = [protocol.draw(s, robot, seconds=SECONDS).furthest for s in range(SEEDS)]
     for side in sides.values():
-        assert side["robots"] == SEEDS and side["survived"] + side["falls"] == SEEDS
-        assert [r["seed"] for r in side["per_seed"]] == list(range(SEEDS))
-        assert [r["furthest"] for r in side["per_seed"]] == furthest
-        lo, hi = side["survival_ci95"]
-        assert lo <= side["survival"] == side["survived"] / SEEDS <= hi
-        assert side["falls"] == sum(r["fell"] for r in side["per_seed"])
-    st = judged["settings"]
-    assert (st["seeds"], st["seconds"], st["engine"]) == (SEEDS, SECONDS, "mujoco")
-    assert st["controllers"] == list(sides) and judged["protocol"]["name"] == "hard"
+        assert side.robots == SEEDS and side.survived + side.falls == SEEDS
+        assert [r.seed for r in side.per_seed] == list(range(SEEDS))
+        assert [r.furthest for r in side.per_seed] == furthest
+        lo, hi = side.survival_ci95
+        assert lo <= side.survival == side.survived / SEEDS <= hi
+        assert side.falls == sum(r.fell for r in side.per_seed)
+    st = judged.settings
+    assert (st.seeds, st.seconds, st.engine) == (SEEDS, SECONDS, "mujoco")
+    assert st.controllers == tuple(sides) and judged.protocol.name == "hard"
+
+
+def test_the_verdict_round_trips_through_its_json(judged):
+    back = ProtocolVerdict.from_dict(json.loads(json.dumps(judged.to_dict())))
+    assert back == judged
 
 
 def test_falls_are_broken_down_by_the_factor_drawn_furthest(judged):
     factors = set(load_protocol("hard").factors)
-    for side in judged["controllers"].values():
-        by = side["falls_by_furthest_factor"]
+    for side in judged.controllers.values():
+        by = side.falls_by_furthest_factor
         assert set(by) >= factors
         # every robot of the hard protocol is perturbed: each fall is under one factor
-        assert sum(by.values()) == side["falls"]
+        assert sum(by.values()) == side.falls
         for factor, count in by.items():
-            fell = [r for r in side["per_seed"] if r["fell"] and r["furthest"] == factor]
+            fell = [r for r in side.per_seed if r.fell and r.furthest == factor]
             assert count == len(fell)
 
 
 def test_each_controller_is_compared_with_open_loop_on_the_same_robots(judged):
-    sides, comp = judged["controllers"], judged["comparison"]
+    sides, comp = judged.controllers, judged.comparison
     assert set(comp) == {"learned", "feedback", "fixed"}
-    base = [r["fell"] for r in sides["open_loop"]["per_seed"]]
+    base = [r.fell for r in sides["open_loop"].per_seed]
     for name, c in comp.items():
-        fell = [r["fell"] for r in sides[name]["per_seed"]]
+        fell = [r.fell for r in sides[name].per_seed]
         assert c == compare_falls(fell, base)
         assert c["robots"] == SEEDS and 0.0 < c["mcnemar_p"] <= 1.0
-        assert c["learned_fall_rate"] == sides[name]["falls"] / SEEDS
+        assert c["learned_fall_rate"] == sides[name].falls / SEEDS
 
 
 def test_a_subset_of_controllers_at_another_scale(tick_run, robot):
     out = judge_protocol(tick_run, robot, load_protocol("eval"), 1, 2.0, ("fixed",), 0.8, 1)
-    assert list(out["controllers"]) == ["fixed"] and out["comparison"] == {}
-    assert out["settings"]["scale"] == 0.8
+    assert list(out.controllers) == ["fixed"] and out.comparison == {}
+    assert out.settings.scale == 0.8
     with pytest.raises(ConfigError, match=r"unknown controller 'x'; valid: feedback, fixed, l"):
         judge_protocol(tick_run, robot, load_protocol("eval"), 1, 2.0, ("learned", "x"))
 
 
 def test_the_breakdown_counts_each_perturbed_robots_fall_once():
-    from imitwalk.judge.verdict import _side
+    from imitwalk.judge.verdict import RobotWalk, _side
+    from imitwalk.sim.metrics import WalkMetrics
 
     def row(seed, fell, furthest):
-        return {"seed": seed, "fell": fell, "fall_time_s": 1.0 if fell else None,
-                "forward_distance_m": 1.0, "forward_speed_mps": 0.1, "yaw_drift_deg": -2.0,
-                "progress_ratio": 0.9, "furthest": furthest}  # fmt: skip
+        m = WalkMetrics(fell=fell, fall_time_s=1.0 if fell else None, seconds=10.0,
+                        forward_distance_m=1.0, forward_speed_mps=0.1, progress_ratio=0.9,
+                        lateral_drift_m=0.0, yaw_drift_deg=-2.0, gyro_rms=0.1,
+                        max_tilt_deg=1.0, joint_rms_error_rad=0.01)  # fmt: skip
+        return RobotWalk(seed, furthest, m)
 
     runs = [row(0, True, None), row(1, True, "mass"), row(2, False, "mass"),
             row(3, True, "slope"), row(4, True, "mass")]  # fmt: skip
     side = _side(runs, ("mass", "slope", "friction"))
-    assert side["falls"] == 4 and side["survived"] == 1
-    assert side["falls_by_furthest_factor"] == {"mass": 2, "slope": 1, "friction": 0}
+    assert side.falls == 4 and side.survived == 1
+    assert side.falls_by_furthest_factor == {"mass": 2, "slope": 1, "friction": 0}
     # the nominal robot (seed 0 of a nominal-first protocol) has no factor to fall under
-    perturbed = sum(r["fell"] for r in runs if r["furthest"] is not None)
-    assert sum(side["falls_by_furthest_factor"].values()) == perturbed
-    assert side["abs_yaw_deg"] == 2.0 and side["progress_ratio_min"] == 0.9
+    perturbed = sum(r.metrics.fell for r in runs if r.furthest is not None)
+    assert sum(side.falls_by_furthest_factor.values()) == perturbed
+    assert side.abs_yaw_deg == 2.0 and side.progress_ratio_min == 0.9

@@ -77,7 +77,7 @@ def test_run_folder_contents(tmp_path, robot, tiny_reference):
     ):
         assert rd.exists(name), name
     log = rd.read_log()
-    assert len(log) == summary["iterations"] >= 2
+    assert len(log) == summary.iterations >= 2
     for e in log:
         assert {
             "scale",
@@ -87,7 +87,7 @@ def test_run_folder_contents(tmp_path, robot, tiny_reference):
             "cost_predicted",
             "prediction",
         } <= set(e)
-    assert summary["sim_seconds_used_for_learning"] == pytest.approx(
+    assert summary.sim_seconds_used_for_learning == pytest.approx(
         sum(e["sim_seconds"] for e in log)
     )
     # the faithful variant's model is judged against the no-action baseline

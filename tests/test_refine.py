@@ -328,3 +328,21 @@ def test_the_command_line_shows_each_refinement_trial(capsys):
         "  refine 1/25: searched: 9/72 fell",
         "  refine 3/75: ds- at 1: 2/24 fell (kept)",
     ]
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        ("generations=0", "generations: 0 is below 1"),
+        ("population=0", "population: 0 is below 1"),
+        ("models=0", "models: 0 is below 1"),
+        ("elites=9", r"elites: 9 is not in 1\.\.8 \(population\)"),
+        ("seconds=0", "seconds: 0.0 is not above 0 s"),
+        ("scales=0.5,1.5", r"scales: \(0\.5, 1\.5\) must be scales in \(0, 1\]"),
+    ],
+)
+def test_search_settings_out_of_range_are_refused(setting, message):
+    from imitwalk.config import apply_overrides
+
+    with pytest.raises(ConfigError, match=f"search_config.{message}"):
+        apply_overrides(RetargetConfig(), [f"search_config.{setting}"])

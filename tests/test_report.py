@@ -61,7 +61,9 @@ def run_dir(tick_run, robot, tmp_path_factory):
     assert main([*bullet, "--controllers", "learned,open_loop"]) == 0  # protocol_bullet.json
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(pushes, "survives", lambda job: job.speed < 0.3)
-        RunDir(out).write_json("push_recovery.json", pushes.push_recovery(out, robot, workers=1))
+        RunDir(out).write_json(
+            "push_recovery.json", pushes.push_recovery(out, robot, workers=1).to_dict()
+        )
     return out
 
 
@@ -127,6 +129,7 @@ def test_missing_files_are_said(bare_report):
 def test_figures_take_empty_data(run_dir):
     from imitwalk.evidence import curves, plots
     from imitwalk.evidence.report import _display_gait
+    from imitwalk.judge.records import PushSettings, PushVerdict
 
     lr = load_run(run_dir)
     gait = _display_gait(lr)
@@ -136,7 +139,7 @@ def test_figures_take_empty_data(run_dir):
         plots.fig6_optimized(gait, lr.scale, []),
         plots.fig7_schedule(gait, []),
         curves.gyro_traces([], [], 0.01),
-        curves.push_polar({"controllers": {}}),
+        curves.push_polar(PushVerdict(PushSettings(1.0, 8, (), 5.0, 0.0, 0.0, ()), {})),
         plots.film_strip([], []),
     ]
     for fig in figs:

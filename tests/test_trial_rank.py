@@ -36,9 +36,9 @@ def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> 
 def test_the_fewest_falls_win_then_the_smallest_gain_whatever_the_cost(rows):
     table = [(round(0.05 * i, 2), _walks(f, cost=c)) for i, (f, _, c) in enumerate(rows)]
     best = min(table, key=lambda row: row[1].rank(row[0]))
-    fewest = min(t.summary()["falls"] for _, t in table)
-    assert best[1].summary()["falls"] == fewest
-    assert best[0] == min(v for v, t in table if t.summary()["falls"] == fewest)
+    fewest = min(t.summary().falls for _, t in table)
+    assert best[1].summary().falls == fewest
+    assert best[0] == min(v for v, t in table if t.summary().falls == fewest)
 
 
 def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit():

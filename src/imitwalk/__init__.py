@@ -11,8 +11,8 @@ MuJoCo)::
 
     robot = iw.load_robot("hoap2")
     ref = iw.retarget(iw.load_motion(iw.default_clip()), robot).reference
-    iw.learn_tick(ref, robot, iw.TickLearnConfig(), "RUN")
-    judged = iw.judge_protocol("RUN", robot, iw.load_protocol("eval"), seeds=40)
+    summary = iw.learn(ref, robot, iw.TickLearnConfig(), "RUN")  # a LearnSummary
+    judged = iw.evaluate_run("RUN", robot, iw.load_protocol("eval"), seeds=40)  # a ProtocolVerdict
 """
 
 from __future__ import annotations
@@ -57,6 +57,9 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "load_protocol": "imitwalk.judge.protocol",
     "judge_protocol": "imitwalk.judge.verdict",
     "push_recovery": "imitwalk.judge.pushes",
+    "LearnSummary": "imitwalk.runs",
+    "ProtocolVerdict": "imitwalk.judge.records",
+    "PushVerdict": "imitwalk.judge.records",
     "write_report": "imitwalk.evidence.report",
 }
 
@@ -65,7 +68,8 @@ def __getattr__(name: str):
     if name in _LAZY:
         import importlib
 
-        module, attr = _LAZY[name] if isinstance(_LAZY[name], tuple) else (_LAZY[name], name)
+        where = _LAZY[name]
+        module, attr = where if isinstance(where, tuple) else (where, name)
         value = getattr(importlib.import_module(module), attr)
         globals()[name] = value
         return value

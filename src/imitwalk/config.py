@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from typing import Any
+from typing import Any, cast
 
 from imitwalk.errors import ConfigError, unknown_name
 
@@ -58,7 +58,7 @@ def _replace(obj: Any, path: list[str], text: str, full: str) -> Any:
         value = _coerce(text, current, full)
     else:
         value = _replace(current, path[1:], text, full)
-    return dataclasses.replace(obj, **{path[0]: value})
+    return dataclasses.replace(cast(Any, obj), **{path[0]: value})
 
 
 def _prefix(full: str, last: str) -> str:

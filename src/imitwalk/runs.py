@@ -13,14 +13,16 @@ RUN_DIR/
 from __future__ import annotations
 
 import json
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
 
-__all__ = ["RunDir"]
+__all__ = ["LearnSummary", "RunDir"]
 
 
 def _json_default(v):
@@ -31,6 +33,51 @@ def _json_default(v):
     if isinstance(v, Path):
         return str(v)
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
+
+
+_TICK_ONLY = ("trial_falls_at_top", "feedback_gains", "trust")
+_FAITHFUL_ONLY = ("variant", "gait")
+
+
+@dataclass(frozen=True)
+class LearnSummary:
+    """What a learner reached and what it cost: the record behind ``metrics.json``.
+
+    Attributes:
+        learner: ``"tick"`` (the per-tick learner) or ``"faithful"`` (the paper's, as written).
+        scale_reached: the largest stride scale learned; scales_passed: every scale passed.
+        iterations: learning iterations run (schedule iterations for ``tick``).
+        sim_seconds_used_for_learning: simulated time of every learning walk [s];
+        wall_seconds_for_learning: wall time [s].
+        config: the learner's settings.
+        trial_falls_at_top: ``tick``: falls of the kept law's trials at the top scale.
+        feedback_gains: ``tick``: the gains the trials kept, by channel.
+        trust: ``tick``: the fraction of the model-based law kept (0: none).
+        variant: ``faithful``: its variant; gait: ``faithful``: its gait model's report.
+    """
+
+    learner: str
+    scale_reached: float
+    scales_passed: list[float]
+    iterations: int
+    sim_seconds_used_for_learning: float
+    wall_seconds_for_learning: float
+    config: dict
+    trial_falls_at_top: int | None = None
+    feedback_gains: dict | None = None
+    trust: float | None = None
+    variant: str | None = None
+    gait: dict | None = None
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary, without the other learner's fields."""
+        other = _FAITHFUL_ONLY if self.learner == "tick" else _TICK_ONLY
+        return {k: v for k, v in asdict(self).items() if k not in other}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> LearnSummary:
+        """The record :meth:`to_dict` wrote (``metrics.json``)."""
+        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
 
 
 class RunDir:
@@ -92,7 +139,7 @@ class RunDir:
 
         def write(tmp: Path) -> None:
             with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
+                np.savez_compressed(fh, **cast(dict[str, Any], arrays))
 
         return atomic_write(self.file(name), write)
 

@@ -107,7 +107,7 @@ def channel_matrix(
     phased = [c for c in channels if c in PHASED]
     if phased and stance is None:
         raise ConfigError(f"channel {phased[0]!r} follows the gait: it needs the stance schedule")
-    pattern = turn_pattern(stance) if phased else np.ones((1, 2))
+    pattern = turn_pattern(stance) if phased and stance is not None else np.ones((1, 2))
     out = np.zeros((len(pattern), len(joint_names), len(channels)))
     for c, name in enumerate(channels):
         for leg, role in enumerate(CHANNELS[name]):

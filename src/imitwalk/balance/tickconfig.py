@@ -71,7 +71,7 @@ class TrialConfig:
         _range("trials.roll", self.roll, -0.5, 0.5)
         _range("trials.heading", self.heading, -2.0, 2.0)
         _range("trials.yaw_limit_deg", (self.yaw_limit_deg,), 0.0, 180.0)
-        _range("trials.box", (self.box,), 0.0, 0.5)
+        _range("trials.box", (self.box,), 0.001, 0.5)
         _range("trials.robots", (self.robots,), 1, 1000)
         _range("trials.seconds", (self.seconds,), 1.0, 600.0)
         _range("trials.heading_robots", (self.heading_robots,), 1, 1000)
@@ -116,8 +116,13 @@ class LqrConfig:
                 f"lqr.state_cost has {len(self.state_cost)} weights for "
                 f"{len(self.features)} features ({', '.join(self.features)})"
             )
+        if self.state_cost:
+            _range("lqr.state_cost", self.state_cost, 0.0, 1e6)
         _range("lqr.explore", (self.explore,), 0.0, 0.2)
-        _range("lqr.box", (self.box,), 0.0, 0.5)
+        _range("lqr.box", (self.box,), 0.001, 0.5)
+        _range("lqr.action_cost", (self.action_cost,), 1e-6, 1e6)
+        _range("lqr.change_cost", (self.change_cost,), 0.0, 1e6)
+        _range("lqr.ridge", (self.ridge,), 0.0, 1e3)
         _range("lqr.trust", self.trust, 0.0, 2.0)
         _range("lqr.width", (self.width,), 0.1, 100.0)
         _range("lqr.horizon", (self.horizon,), 1, 1000)
@@ -167,6 +172,8 @@ class TickLearnConfig:
         _range("iterations", (self.iterations,), 1, 100)
         _range("robots", (self.robots,), 1, 1000)
         _range("seconds", (self.seconds,), 1.0, 600.0)
+        if self.workers is not None:
+            _range("workers", (self.workers,), 1, 256)
         load_protocol(self.train_protocol)  # a one-line error if unknown
 
     def scales(self) -> tuple[float, ...]:

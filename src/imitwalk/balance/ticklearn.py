@@ -49,7 +49,7 @@ from imitwalk.judge.protocol import load_protocol
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
-from imitwalk.runs import RunDir
+from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.sim.perturb import TRAIN_SEED_BASE, TRIAL_SEED_BASE
 
 __all__ = ["TickProgress", "learn_tick"]
@@ -142,7 +142,7 @@ def _say_table(lr: _Learner, head: str, table) -> None:
     cells = []
     for v, t in table:
         s = t.summary()
-        cells.append(f"[{v:g}: {s['falls']}/{s['robots']} fell, {s['abs_yaw_deg']:.1f} deg]")
+        cells.append(f"[{v:g}: {s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg]")
     lr.say(f"{head} {' '.join(cells)}")
 
 
@@ -161,7 +161,7 @@ def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
         state.gains[name] = best
         log.append(
             {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
-             "kept": best, "table": [{"value": v, **t.summary()} for v, t in table]}
+             "kept": best, "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
         )  # fmt: skip
         _say_table(lr, f"trials: {feature} -> {channel} = {best:g}", table)
         state.trial += 1
@@ -209,7 +209,7 @@ def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> Feedb
         learned, model = _learned_law(lr, near)
         fell = sum(r.fell for r in res)
         entry = {"stage": "schedule", "scale": scale, "iteration": state.iteration,
-                 "explore": explore, **summarize(res), "held_out": held}  # fmt: skip
+                 "explore": explore, **summarize(res).to_dict(), "held_out": held}  # fmt: skip
         log.append(entry)
         ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
         lr.say(
@@ -246,7 +246,7 @@ def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | 
     best = min(table, key=lambda row: row[1].rank(row[0]))[0]
     state.trust, state.stage = best, "done"
     log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
-                "table": [{"fraction": f, **t.summary()} for f, t in table]})  # fmt: skip
+                "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table]})  # fmt: skip
     _say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
 
 
@@ -259,7 +259,7 @@ def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None 
 
 def learn_tick(
     ref: Reference, robot: Robot, config: TickLearnConfig, run_dir, resume=False, progress=None
-) -> dict:
+) -> LearnSummary:
     """Learn to walk ``ref`` on ``robot`` with per-tick feedback; write ``run_dir``.
 
     Returns:
@@ -286,17 +286,17 @@ def learn_tick(
     row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
     top_falls = int(row["falls"])
     reached = lr.scales[-1] if top_falls == 0 else max(state.passed, default=lr.scales[0])
-    summary = {
-        "learner": "tick",
-        "scale_reached": reached,
-        "trial_falls_at_top": top_falls,
-        "scales_passed": state.passed,
-        "feedback_gains": state.gains,
-        "trust": state.trust,
-        "iterations": sum(1 for e in log if e["stage"] == "schedule"),
-        "sim_seconds_used_for_learning": state.sim_seconds,
-        "wall_seconds_for_learning": state.wall_seconds,
-        "config": to_dict(config),
-    }
-    rd.write_json("metrics.json", summary)
+    summary = LearnSummary(
+        learner="tick",
+        scale_reached=reached,
+        scales_passed=state.passed,
+        iterations=sum(1 for e in log if e["stage"] == "schedule"),
+        sim_seconds_used_for_learning=state.sim_seconds,
+        wall_seconds_for_learning=state.wall_seconds,
+        config=to_dict(config),
+        trial_falls_at_top=top_falls,
+        feedback_gains=state.gains,
+        trust=state.trust,
+    )
+    rd.write_json("metrics.json", summary.to_dict())
     return summary

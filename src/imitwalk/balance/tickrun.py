@@ -6,7 +6,7 @@ The learner (:mod:`imitwalk.balance.ticklearn`) runs many of these in parallel
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -14,7 +14,7 @@ from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
 from imitwalk.robots import Robot
 from imitwalk.sim.types import SimOptions
 
-__all__ = ["TickJob", "TickResult", "Trial", "run_tick_episode", "summarize"]
+__all__ = ["TickJob", "TickResult", "Trial", "WalkSummary", "run_tick_episode", "summarize"]
 
 
 @dataclass(frozen=True)
@@ -106,18 +106,35 @@ def run_tick_episode(job: TickJob) -> TickResult:
     )
 
 
-def summarize(results: list[TickResult]) -> dict:
-    """Falls, robots, mean Γ of the robots that stayed up [rad²/s²], seconds walked [s],
-    mean forward distance [m] and mean |yaw| [deg] of some walks."""
+@dataclass(frozen=True)
+class WalkSummary:
+    """Some walks in a few numbers: falls, robots, mean Γ of the robots that stayed up
+    [rad²/s²] (``inf`` if none did), seconds walked in all [s], mean forward distance [m]
+    and mean |yaw drift| [deg]."""
+
+    falls: int
+    robots: int
+    cost: float
+    walked_s: float
+    distance_m: float
+    abs_yaw_deg: float
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary (a row of the learning log's tables)."""
+        return asdict(self)
+
+
+def summarize(results: list[TickResult]) -> WalkSummary:
+    """:class:`WalkSummary` of ``results``."""
     up = [r for r in results if not r.fell]
-    return {
-        "falls": int(sum(r.fell for r in results)),
-        "robots": len(results),
-        "cost": float(np.mean([r.cost for r in up])) if up else float("inf"),
-        "walked_s": float(sum(r.seconds for r in results)),
-        "distance_m": float(np.mean([r.distance_m for r in results])),
-        "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in results])),
-    }
+    return WalkSummary(
+        falls=int(sum(r.fell for r in results)),
+        robots=len(results),
+        cost=float(np.mean([r.cost for r in up])) if up else float("inf"),
+        walked_s=float(sum(r.seconds for r in results)),
+        distance_m=float(np.mean([r.distance_m for r in results])),
+        abs_yaw_deg=float(np.mean([abs(r.yaw_drift_deg) for r in results])),
+    )
 
 
 @dataclass(frozen=True)
@@ -133,8 +150,9 @@ class Trial:
         Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
         the gain where robots start to fall (docs/RESULTS.md)."""
         s = self.summary()
-        drift = 0.0 if yaw_limit_deg is None else max(0.0, s["abs_yaw_deg"] - yaw_limit_deg)
-        return (s["falls"], drift, abs(value))
+        drift = 0.0 if yaw_limit_deg is None else max(0.0, s.abs_yaw_deg - yaw_limit_deg)
+        return (s.falls, drift, abs(value))
 
-    def summary(self) -> dict:
+    def summary(self) -> WalkSummary:
+        """:func:`summarize` of its walks."""
         return summarize(self.results)

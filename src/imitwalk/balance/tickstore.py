@@ -83,7 +83,7 @@ def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
     fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
         "ankle_pitch", "gyro_y", 0.05
     )
-    learned = (base,)
+    learned: tuple[FeedbackLaw, ...] = (base,)
     frac = float(metrics.get("trust") or 0.0)
     law = load_learned(rd)
     if frac > 0 and law is not None:

@@ -3,55 +3,20 @@
 from __future__ import annotations
 
 import argparse
-import json
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+from imitwalk.cli.progress import emit, progress
 
-from imitwalk.cli.progress import progress
+if TYPE_CHECKING:
+    from imitwalk.runs import LearnSummary
 
 __all__ = [
-    "emit",
     "playback",
     "retarget",
     "robot_from",
 ]
-
-
-def emit(obj: dict, as_json: bool, finite: bool = False) -> None:
-    """Print ``obj`` as JSON, or as aligned ``key: value`` lines; ``finite``: a NaN or an
-    infinity (a servo without a torque limit) is printed as ``null``, so the JSON is valid."""
-    if finite:
-        obj = _finite(obj)
-    if as_json:
-        print(json.dumps(obj, indent=2, default=_plain, allow_nan=not finite))
-        return
-    for key, val in obj.items():
-        if isinstance(val, dict | list):
-            text = json.dumps(val, default=_plain)
-            val = text if len(text) <= 90 else text[:87] + "..."
-        elif isinstance(val, float):
-            val = f"{val:.4g}"
-        print(f"{key:>28}: {val}")
-
-
-def _finite(v):
-    """``v`` with every non-finite float (also in dicts and lists) replaced by ``None``."""
-    if isinstance(v, dict):
-        return {k: _finite(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_finite(x) for x in v]
-    if isinstance(v, float | np.floating) and not np.isfinite(v):
-        return None
-    return v
-
-
-def _plain(v):
-    if hasattr(v, "item"):
-        return v.item()
-    if hasattr(v, "tolist"):
-        return v.tolist()
-    return str(v)
 
 
 def robot_from(args: argparse.Namespace):
@@ -174,14 +139,16 @@ def learn(args: argparse.Namespace) -> int:
     rt_set, learn_set = _split_settings(args.set)
     if args.variant == "faithful":
         from imitwalk.paper.learnconfig import preset
-        from imitwalk.paper.learner import learn as run
+        from imitwalk.paper.learner import learn as faithful
 
-        cfg = apply_overrides(preset("faithful", seed=args.seed), learn_set)
+        cfg: Any = apply_overrides(preset("faithful", seed=args.seed), learn_set)
+        run: Callable[..., LearnSummary] = faithful
     else:
         from imitwalk.balance.tickconfig import TickLearnConfig
-        from imitwalk.balance.ticklearn import learn_tick as run
+        from imitwalk.balance.ticklearn import learn_tick
 
         cfg = apply_overrides(TickLearnConfig(seed=args.seed), learn_set)
+        run = learn_tick
     rd = RunDir(args.out)
     rd.check_writable()
     flags = [
@@ -215,7 +182,7 @@ def learn(args: argparse.Namespace) -> int:
         ref.settings["joint_map"] = _where(args.joint_map)
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
-    out = {k: v for k, v in summary.items() if k not in ("config", "gait")}
+    out = {k: v for k, v in summary.to_dict().items() if k not in ("config", "gait")}
     out["variant"] = args.variant
     out["run_dir"] = str(rd.path)
     emit(out, args.json)
@@ -249,16 +216,16 @@ def evaluate(args: argparse.Namespace) -> int:
         rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
         scale=args.scale, workers=args.workers,
     )  # fmt: skip
-    for name, side in out["controllers"].items():
-        lo, hi = side["survival_ci95"]
+    for name, side in out.controllers.items():
+        lo, hi = side.survival_ci95
         progress(
-            f"  {name:>10}: survived {side['survived']}/{side['robots']} "
-            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side['distance_m']:.2f} m, "
-            f"|yaw| {side['abs_yaw_deg']:.1f} deg"
+            f"  {name:>10}: survived {side.survived}/{side.robots} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side.distance_m:.2f} m, "
+            f"|yaw| {side.abs_yaw_deg:.1f} deg"
         )
     scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    rd.write_json(f"protocol_{protocol.name}{scale}.json", out)
-    emit(out, args.json)
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out.to_dict())
+    emit(out.to_dict(), args.json)
     return 0
 
 
@@ -280,13 +247,13 @@ def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
     progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")
     chosen = tuple(args.controllers.split(",")) if args.controllers else None
     out = push_recovery(rd.path, robot, controllers=chosen, scale=args.scale, workers=args.workers)
-    for name, side in out["controllers"].items():
-        least = side["min_by_direction"].items()
+    for name, side in out.controllers.items():
+        least = side.min_by_direction.items()
         progress(
             f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
         )
-    rd.write_json("push_recovery.json", out)
-    emit(out, args.json)
+    rd.write_json("push_recovery.json", out.to_dict())
+    emit(out.to_dict(), args.json)
     return 0
 
 

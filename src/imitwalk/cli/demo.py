@@ -70,15 +70,15 @@ def run_demo(out: Path) -> dict:
         learn_tick(ref, robot, lcfg, out, resume=resume, progress=lambda s: progress("      " + s))
     progress("[3/4] evaluate: every controller on the eval protocol's first 8 robots x 20 s")
     ev = judge_protocol(out, robot, load_protocol("eval"), 8, 20.0)
-    rd.write_json("protocol_eval.json", ev)
+    rd.write_json("protocol_eval.json", ev.to_dict())
     progress("[4/4] report: figures, film strips, video")
     report = write_report(out, robot, progress=lambda s: progress("      " + s))
-    side = ev["controllers"]
+    side = ev.controllers
     summary = {
         "report": str(report),
-        "scale_reached": ev["settings"]["scale"],
-        **{f"{name}_falls": f"{v['falls']}/{v['robots']}" for name, v in side.items()},
-        "learned_speed_mps": side["learned"]["speed_mps"],
+        "scale_reached": ev.settings.scale,
+        **{f"{name}_falls": f"{v.falls}/{v.robots}" for name, v in side.items()},
+        "learned_speed_mps": side["learned"].speed_mps,
         "wall_seconds": time.perf_counter() - t0,
     }
     progress(f"demo: report written to {report}")

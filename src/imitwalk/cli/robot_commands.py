@@ -6,8 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
-from imitwalk.cli.commands import emit, robot_from
-from imitwalk.cli.progress import progress
+from imitwalk.cli.commands import robot_from
+from imitwalk.cli.progress import emit, progress
 
 __all__ = ["robot_import", "robot_info", "robot_stand"]
 

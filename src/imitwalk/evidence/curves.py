@@ -10,9 +10,11 @@ from collections.abc import Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.projections.polar import PolarAxes
 from matplotlib.ticker import MaxNLocator
 
 from imitwalk.evidence.plots import _figure
+from imitwalk.judge.records import PushVerdict
 
 __all__ = ["gyro_traces", "learning_curves", "push_polar", "tick_curves", "torso_paths"]
 
@@ -151,26 +153,28 @@ def tick_curves(log: Sequence[dict]) -> Figure:
     return fig
 
 
-def push_polar(result: dict) -> Figure:
+def push_polar(result: PushVerdict) -> Figure:
     """Push recovery (:func:`imitwalk.judge.pushes.push_recovery`) as a polar plot: for each
     controller, the largest kick survived [m/s] at each direction (the phases of the
     gait cycle spread around it, ±20°)."""
     fig = _figure(6.0, 6.0)
     ax = fig.add_subplot(projection="polar")
+    assert isinstance(ax, PolarAxes)  # what projection="polar" makes
     angles = {"forward": 0.0, "left": np.pi / 2, "back": np.pi, "right": -np.pi / 2}
     colors = ("tab:green", "tab:blue", "tab:orange", "tab:gray")
-    for (name, side), color in zip(result.get("controllers", {}).items(), colors, strict=False):
-        th, r = [], []
-        for d, speeds in side["table"].items():
+    for (name, side), color in zip(result.controllers.items(), colors, strict=False):
+        dirs: list[float] = []  # the direction of each point [rad]
+        kicks: list[float] = []  # the largest kick survived there [m/s]
+        for d, speeds in side.table.items():
             spread = np.linspace(-np.pi / 9, np.pi / 9, len(speeds))
-            th.extend(angles[d] + spread)
-            r.extend(speeds)
-        order = np.argsort(np.mod(th, 2 * np.pi))
-        th, r = np.mod(np.asarray(th)[order], 2 * np.pi), np.asarray(r)[order]
+            dirs.extend(angles[d] + spread)
+            kicks.extend(speeds)
+        order = np.argsort(np.mod(dirs, 2 * np.pi))
+        th, r = np.mod(np.asarray(dirs)[order], 2 * np.pi), np.asarray(kicks)[order]
         ax.plot(np.r_[th, th[:1]], np.r_[r, r[:1]], "o-", color=color, ms=3, lw=1, label=name)
     ax.set_theta_zero_location("N")
     ax.set_xticks(list(angles.values()), list(angles))
-    top = result.get("settings", {}).get("top_mps")
+    top = result.settings.top_mps
     if top:
         ax.set_ylim(0, top)
     ax.set_title("Largest kick survived for 5 s [m/s], by direction and gait phase", fontsize=9)

@@ -90,9 +90,9 @@ def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> 
 
     img = Image.fromarray(frame)
     draw = ImageDraw.Draw(img)
-    style = {"font": ImageFont.load_default(size=15), "stroke_width": 2, "stroke_fill": "white"}
+    font = ImageFont.load_default(size=15)
     for i, (text, color) in enumerate(lines):
-        draw.text((8, 6 + 18 * i), text, fill=color, **style)
+        draw.text((8, 6 + 18 * i), text, fill=color, font=font, stroke_width=2, stroke_fill="white")
     return np.asarray(img)
 
 
@@ -112,8 +112,10 @@ def video(robot: Robot, runs: list[tuple[str, Rollout]], seconds: float, s: Repo
         for k, f in enumerate(frames):
             t = k / s.fps
             lines = [(name, (0, 0, 0)), (f"t = {t:4.1f} s", (40, 40, 40))]
-            if ro.fell and t >= ro.fall_time:
-                lines.append((f"fell at {ro.fall_time:.1f} s", (200, 0, 0)))
+            if ro.fell:
+                assert ro.fall_time is not None  # a run that fell says when
+                if t >= ro.fall_time:
+                    lines.append((f"fell at {ro.fall_time:.1f} s", (200, 0, 0)))
             out.append(_label(f, lines))
         halves.append(out)
     gap = np.full((s.height, 4, 3), 255, np.uint8)
@@ -174,6 +176,7 @@ class Replays:
         last two gait cycles (up to its fall)."""
         q = self.after.q_cmd
         if self.after.fell:
+            assert self.after.fall_time is not None  # a run that fell says when
             q = q[: max(1, round(self.after.fall_time / self.after.control_dt))]
         return gait.subspace.transform(q[-2 * gait.n_ticks :])
 
@@ -204,6 +207,7 @@ def replay(run_, robot: Robot, seconds: float, scale: float | None = None, optio
     (before, _), (after, policy) = runs
     actions = np.asarray(getattr(policy, "tick_actions", []), dtype=float).reshape(-1, 3)
     if after.fell and len(actions):
+        assert after.fall_time is not None  # a run that fell says when
         first = policy.first_loop_tick
         actions = actions[: max(0, round(after.fall_time / after.control_dt) - first)]
     return Replays(scale, before, after, actions)

@@ -100,7 +100,7 @@ def fig3_subspace(
     X = _pcs(gait, scale)  # (N, 3)
     fitted = gait.embedding(scale).loop(200)[:, :3]
     count = len(pose_images) if pose_images else 6
-    ticks = example_ticks(len(X), count) if ticks is None else np.asarray(ticks, dtype=int)
+    picked = example_ticks(len(X), count) if ticks is None else np.asarray(ticks, dtype=int)
     cols = min(3, len(pose_images)) if pose_images else 0
     rows = int(np.ceil(len(pose_images) / cols)) if pose_images else 1
     fig = _figure(6.0 + 2.0 * cols, 5.5)
@@ -109,7 +109,7 @@ def fig3_subspace(
     ax.plot(*fitted.T, color="tab:blue", lw=1.0)
     every = max(1, len(X) // 24)
     ax.scatter(*X[::every].T, marker="D", s=14, color="tab:blue", label="postures of one cycle")
-    P = X[ticks]
+    P = X[picked]
     ax.scatter(*P.T, s=70, lw=1.8, label="example poses", **RINGS)
     for i, p in enumerate(P):
         ax.text(*p, f" {i + 1}", color="red", fontsize=10, weight="bold")

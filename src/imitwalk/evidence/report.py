@@ -21,6 +21,7 @@ from pathlib import Path
 from imitwalk.evidence import curves, media, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.judge import tables
+from imitwalk.judge.records import ProtocolVerdict, PushVerdict
 from imitwalk.judge.replay import load_run
 from imitwalk.paper.gait import GaitConfig, GaitModel
 from imitwalk.robots import Robot, load_robot
@@ -180,7 +181,9 @@ def _evaluations(rd: RunDir) -> str:
             '<p class="missing">No <code>protocol_*.json</code>: run '
             "<code>imitwalk evaluate RUN --protocol eval</code> (or hard, bullet).</p>"
         )
-    return "".join(tables.protocol_table(rd.read_json(name)) for name in found)
+    return "".join(
+        tables.protocol_table(ProtocolVerdict.from_dict(rd.read_json(name))) for name in found
+    )
 
 
 def _robustness(rd: RunDir, kick: tuple) -> str:
@@ -191,7 +194,7 @@ def _robustness(rd: RunDir, kick: tuple) -> str:
             '<p class="missing">No <code>push_recovery.json</code>: run '
             "<code>imitwalk evaluate RUN --push-recovery</code>.</p>"
         )
-    res = rd.read_json("push_recovery.json")
+    res = PushVerdict.from_dict(rd.read_json("push_recovery.json"))
     return _img(curves.push_polar(res), "push recovery") + tables.push_table(res) + body
 
 

@@ -41,32 +41,17 @@ import math
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.stats import chi2, norm
 
 from imitwalk.errors import ConfigError, unknown_name
-from imitwalk.sim.types import ENGINES, SimOptions, jitter_draws
+from imitwalk.judge.protocolcheck import FACTORS, checked, fail
+from imitwalk.sim.types import SimOptions, jitter_draws
 
 __all__ = ["FACTORS", "PROTOCOLS", "Protocol", "RobotDraw", "load_protocol"]
 
-#: Every factor a protocol may draw, with the keys it takes (``source`` is always allowed
-#: and always required: where the range comes from).
-FACTORS: dict[str, tuple[str, ...]] = {
-    "friction": ("min", "max", "nominal"),
-    "mass": ("spread",),
-    "servo": ("spread",),
-    "torso_com": ("max_m", "at_height_m"),
-    "gyro_noise": ("sigma",),
-    "accel_noise": ("sigma",),
-    "servo_delay": ("min_s", "max_s"),
-    "slope": ("min_deg", "max_deg"),
-    "pushes": ("every_min_s", "every_max_s", "max_speed", "at_height_m"),
-    "initial_twist": ("linear", "angular"),
-}
-_TOP = ("name", "version", "description", "engine", "nominal_first", "factors")
-#: (low, high) key pairs that must be ordered.
-_ORDERED = (("min", "max"), ("min_s", "max_s"), ("min_deg", "max_deg"))
 #: The stream of each factor that does not share the legacy one (see the module doc).
 _STREAM = {"torso_com": 1, "servo_delay": 2, "slope": 3, "pushes": 4}
 _LEGACY = 20070106
@@ -124,7 +109,9 @@ class Protocol:
         base = base or SimOptions()
         if seed == 0 and self.nominal_first:
             return RobotDraw(0, replace(base, seed=0))
-        f, dev, opt = self.factors, {}, {"seed": seed}
+        f = self.factors
+        dev: dict[str, float] = {}
+        opt: dict[str, Any] = {"seed": seed}
         legacy = np.random.default_rng([seed, _LEGACY])
         twist = np.concatenate([legacy.normal(0, 1, 3), legacy.normal(0, 1, 3)])
         u_friction = legacy.random()
@@ -163,9 +150,9 @@ class Protocol:
                 opt[key] = f[key]["sigma"]
         if "servo_delay" in f:
             lo, hi = f["servo_delay"]["min_s"], f["servo_delay"]["max_s"]
-            u = self._stream(seed, "servo_delay").random()
-            opt["servo_delay"] = lo + (hi - lo) * u
-            dev["servo_delay"] = float(u)
+            r = self._stream(seed, "servo_delay").random()
+            opt["servo_delay"] = lo + (hi - lo) * r
+            dev["servo_delay"] = float(r)
         if "slope" in f:
             lo, hi = f["slope"]["min_deg"], f["slope"]["max_deg"]
             value = lo + (hi - lo) * self._stream(seed, "slope").random()
@@ -232,69 +219,6 @@ def _spread_percentile(u: np.ndarray) -> float:
     return float(norm.cdf(z))
 
 
-def _fail(where: str, what: str) -> ConfigError:
-    return ConfigError(f"protocol {where}: {what}")
-
-
-def _check(data: dict, where: str) -> Protocol:
-    if not isinstance(data, dict):
-        raise _fail(where, "expected a JSON object")
-    for key in data:
-        if key not in _TOP:
-            raise unknown_name(f"key in protocol {where}", key, _TOP, ConfigError)
-    for key in ("name", "factors"):
-        if key not in data:
-            raise _fail(where, f"has no {key!r}")
-    engine = data.get("engine", "mujoco")
-    if engine not in ENGINES:
-        raise unknown_name(f"engine in protocol {where}", str(engine), ENGINES, ConfigError)
-    factors = data["factors"]
-    if not isinstance(factors, dict):
-        raise _fail(where, "'factors' must be an object of factor -> range")
-    out = {}
-    for name, spec in factors.items():
-        if name not in FACTORS:
-            raise unknown_name(f"factor in protocol {where}", name, FACTORS, ConfigError)
-        if not isinstance(spec, dict):
-            raise _fail(where, f"factor {name!r} must be an object")
-        keys = (*FACTORS[name], "source")
-        for key in spec:
-            if key not in keys:
-                raise unknown_name(f"key of factor {name!r} in {where}", key, keys, ConfigError)
-        for key in keys:
-            if key not in spec:
-                raise _fail(where, f"factor {name!r} lacks {key!r}")
-        vals = {k: v for k, v in spec.items() if k != "source"}
-        for key, v in vals.items():
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise _fail(where, f"{name}.{key} must be a finite number, got {v!r}")
-            if v < 0 and key not in ("min_deg", "max_deg"):
-                raise _fail(where, f"{name}.{key} is negative ({v})")
-        for lo, hi in _ORDERED:
-            if lo in vals and vals[lo] > vals[hi]:
-                raise _fail(where, f"{name}: {lo} {vals[lo]} is above {hi} {vals[hi]}")
-        if name == "pushes" and vals["every_min_s"] <= 0:
-            raise _fail(where, "pushes.every_min_s must be above 0")
-        if name in ("mass", "servo") and vals["spread"] >= 1:
-            raise _fail(where, f"{name}.spread must be below 1, got {vals['spread']}")
-        for key in ("at_height_m",):
-            if key in vals and vals[key] <= 0:
-                raise _fail(where, f"{name}.{key} must be above 0")
-        out[name] = {**{k: float(v) for k, v in vals.items()}, "source": str(spec["source"])}
-    version = data.get("version", 1)
-    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
-        raise _fail(where, f"version must be a whole number >= 1, got {version!r}")
-    return Protocol(
-        name=str(data["name"]),
-        version=version,
-        description=str(data.get("description", "")),
-        engine=engine,
-        nominal_first=bool(data.get("nominal_first", False)),
-        factors=out,
-        path=where,
-    )
-
-
 def load_protocol(name_or_path: str | Path) -> Protocol:
     """A shipped protocol by name (:data:`PROTOCOLS`), or a protocol file (``.json``).
 
@@ -322,5 +246,5 @@ def load_protocol(name_or_path: str | Path) -> Protocol:
         data = json.loads(raw)
     except (json.JSONDecodeError, RecursionError) as exc:
         msg = exc.msg if isinstance(exc, json.JSONDecodeError) else "nested too deeply"
-        raise _fail(where, f"not valid JSON: {msg}") from None
-    return _check(data, where)
+        raise fail(where, f"not valid JSON: {msg}") from None
+    return Protocol(**checked(data, where), path=where)

@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from imitwalk.judge.records import PushSettings, PushSide, PushVerdict
 from imitwalk.judge.replay import load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
@@ -90,14 +91,13 @@ def survives(job: PushJob) -> bool:
 
 def push_recovery(
     run_dir, robot: Robot, controllers=None, scale: float | None = None, workers=None
-) -> dict:
+) -> PushVerdict:
     """The largest kick survived per controller, direction and phase (a table [m/s]).
 
     Returns:
-        ``{"settings": …, "controllers": {name: {"table": {direction: [speed per
-        phase]}, "min_by_direction": …, "mean": …}}}``; a speed equal to ``top`` means
-        "survived the largest kick tried", 0 that even no kick is survived (the walk
-        falls by itself).
+        a :class:`~imitwalk.judge.records.PushVerdict`; in its tables a speed equal to
+        ``top_mps`` means "survived the largest kick tried", 0 that even no kick is
+        survived (the walk falls by itself).
     """
     lr = load_run(run_dir)
     names = lr.controllers() if controllers is None else tuple(controllers)
@@ -130,23 +130,21 @@ def push_recovery(
                 lo[cell] = mids[cell]
             else:
                 hi[cell] = mids[cell]
-    out = {
-        "settings": {
-            "scale": scale,
-            "phases": PHASES,
-            "directions": list(DIRECTIONS),
-            "after_s": AFTER_S,
-            "top_mps": top,
-            "resolution_mps": top / 2**STEPS,
-            "kick_times_s": [kick_time(lr.ref, p) for p in range(PHASES)],
-        },
-        "controllers": {},
-    }
+    settings = PushSettings(
+        scale=scale,
+        phases=PHASES,
+        directions=tuple(DIRECTIONS),
+        after_s=AFTER_S,
+        top_mps=top,
+        resolution_mps=top / 2**STEPS,
+        kick_times_s=tuple(kick_time(lr.ref, p) for p in range(PHASES)),
+    )
+    sides = {}
     for c in names:
         table = {d: [lo[(c, d, p)] for p in range(PHASES)] for d in DIRECTIONS}
-        out["controllers"][c] = {
-            "table": table,
-            "min_by_direction": {d: float(min(v)) for d, v in table.items()},
-            "mean": float(np.mean([v for row in table.values() for v in row])),
-        }
-    return out
+        sides[c] = PushSide(
+            table=table,
+            min_by_direction={d: float(min(v)) for d, v in table.items()},
+            mean=float(np.mean([v for row in table.values() for v in row])),
+        )
+    return PushVerdict(settings, sides)

@@ -10,12 +10,16 @@ controller by name. ``open_loop`` (the reference played as it is) is every run's
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import RunDir
+
+if TYPE_CHECKING:
+    from imitwalk.paper.evaluate import LearnedGait
 
 __all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
 
@@ -52,7 +56,7 @@ class LoadedRun:
     engine: str
     metrics: dict
     laws: dict | None = None
-    gait: object | None = None
+    gait: LearnedGait | None = None
 
     def controllers(self) -> tuple[str, ...]:
         """The controllers it can build, ``open_loop`` last."""
@@ -91,6 +95,7 @@ class LoadedRun:
             from imitwalk.balance.feedback import TickPolicy
 
             return TickPolicy(self.ref, scale, self.laws[controller], robot.joint_names, seconds)
+        assert self.gait is not None  # a faithful run's
         return self.gait.policy(scale)
 
 

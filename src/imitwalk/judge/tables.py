@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import html
 
+from imitwalk.judge.records import ProtocolVerdict, PushVerdict
+
 __all__ = ["protocol_table", "push_table"]
 
 
@@ -11,13 +13,15 @@ def _pct(lo: float, hi: float) -> str:
     return f"{100 * lo:.0f}–{100 * hi:.0f} %"
 
 
-def protocol_table(result: dict) -> str:
+def _num(x: float | None, fmt: str) -> str:
+    return "–" if x is None else format(x, fmt)
+
+
+def protocol_table(result: ProtocolVerdict) -> str:
     """One protocol's judgement (:func:`imitwalk.judge.verdict.judge_protocol`): a row per
     controller, and the falls by the factor each robot drew furthest from nominal."""
-    p, st = result.get("protocol", {}), result.get("settings", {})
-    sides = result.get("controllers", {})
-    comp = result.get("comparison", {})
-    factors = sorted({f for s in sides.values() for f in s["falls_by_furthest_factor"]})
+    p, st, sides, comp = result.protocol, result.settings, result.controllers, result.comparison
+    factors = sorted({f for s in sides.values() for f in s.falls_by_furthest_factor})
     head = (
         "<tr><th>controller</th><th>survived</th><th>95 % CI</th><th>distance [m]</th>"
         "<th>speed [m/s]</th><th>mean |yaw| [°]</th><th>McNemar p vs open loop</th>"
@@ -29,41 +33,41 @@ def protocol_table(result: dict) -> str:
         pval = comp.get(name, {}).get("mcnemar_p")
         cells = [
             html.escape(name),
-            f"{s['survived']}/{s['robots']}",
-            _pct(*s["survival_ci95"]),
-            f"{s['distance_m']:.2f}",
-            f"{s['speed_mps']:.3f}",
-            f"{s['abs_yaw_deg']:.1f}",
+            f"{s.survived}/{s.robots}",
+            _pct(*s.survival_ci95),
+            _num(s.distance_m, ".2f"),
+            _num(s.speed_mps, ".3f"),
+            _num(s.abs_yaw_deg, ".1f"),
             "–" if pval is None else f"{pval:.3g}",
-            *(str(s["falls_by_furthest_factor"].get(f, 0)) for f in factors),
+            *(str(s.falls_by_furthest_factor.get(f, 0)) for f in factors),
         ]
         rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
     caption = (
-        f"<p>Protocol <b>{html.escape(str(p.get('name')))}</b> v{p.get('version')}: "
-        f"{st.get('seeds')} robots × {st.get('seconds')} s on {html.escape(str(st.get('engine')))}"
-        f", scale {st.get('scale')}. A fall is counted under the factor its robot drew "
+        f"<p>Protocol <b>{html.escape(p.name)}</b> v{p.version}: "
+        f"{st.seeds} robots × {st.seconds} s on {html.escape(st.engine)}"
+        f", scale {st.scale}. A fall is counted under the factor its robot drew "
         "furthest from nominal.</p>"
     )
     return caption + "<table>" + head + "".join(rows) + "</table>"
 
 
-def push_table(result: dict) -> str:
+def push_table(result: PushVerdict) -> str:
     """Push recovery (:func:`imitwalk.judge.pushes.push_recovery`): the largest kick survived
     [m/s], a row per controller and direction, a column per phase of the gait cycle."""
-    st = result.get("settings", {})
-    n = int(st.get("phases", 0))
+    st = result.settings
+    n = st.phases
     head = "<tr><th>controller</th><th>direction</th>" + "".join(
         f"<th>phase {k}/{n}</th>" for k in range(n)
     )
     rows = []
-    for name, side in result.get("controllers", {}).items():
-        for d, speeds in side["table"].items():
+    for name, side in result.controllers.items():
+        for d, speeds in side.table.items():
             cells = "".join(f"<td>{v:.2f}</td>" for v in speeds)
             rows.append(f"<tr><td>{html.escape(name)}</td><td>{d}</td>{cells}</tr>")
     note = (
-        f"<p>Nominal robot at scale {st.get('scale')}, one kick two cycles after the start-up; "
-        f"the robot must stay up {st.get('after_s')} s after it. Bisection to "
-        f"{st.get('resolution_mps', 0):.3f} m/s; {st.get('top_mps', 0):.2f} means it "
+        f"<p>Nominal robot at scale {st.scale}, one kick two cycles after the start-up; "
+        f"the robot must stay up {st.after_s} s after it. Bisection to "
+        f"{st.resolution_mps:.3f} m/s; {st.top_mps:.2f} means it "
         "survived the largest kick tried.</p>"
     )
     return note + "<table>" + head + "</tr>" + "".join(rows) + "</table>"

@@ -17,15 +17,22 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.judge.protocol import Protocol
+from imitwalk.judge.records import (
+    ControllerVerdict,
+    JudgeSettings,
+    ProtocolId,
+    ProtocolVerdict,
+    SeedRow,
+)
 from imitwalk.judge.replay import OPEN_LOOP, LoadedRun, load_run
 from imitwalk.paper.evaluate import compare_falls, wilson
 from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
-from imitwalk.sim.metrics import walk_metrics
+from imitwalk.sim.metrics import WalkMetrics, walk_metrics
 from imitwalk.sim.types import SimOptions
 
-__all__ = ["JudgeJob", "judge_protocol", "run_controller"]
+__all__ = ["JudgeJob", "RobotWalk", "judge_protocol", "run_controller"]
 
 
 @dataclass(frozen=True)
@@ -50,7 +57,24 @@ class JudgeJob:
     engine: str
 
 
-_CACHE: dict = {}
+@dataclass(frozen=True)
+class RobotWalk:
+    """What :func:`run_controller` measured: the robot's seed, the factor it drew furthest
+    from nominal, and its walk."""
+
+    seed: int
+    furthest: str | None
+    metrics: WalkMetrics
+
+    def row(self) -> SeedRow:
+        """Its row in a verdict."""
+        m = self.metrics
+        return SeedRow(
+            self.seed, m.fell, m.fall_time_s, m.forward_distance_m, self.furthest, m.yaw_drift_deg
+        )
+
+
+_CACHE: dict[tuple[str, int], LoadedRun] = {}
 
 
 def _loaded(run_dir: str) -> LoadedRun:
@@ -61,7 +85,7 @@ def _loaded(run_dir: str) -> LoadedRun:
     return _CACHE[key]
 
 
-def run_controller(job: JudgeJob) -> dict:
+def run_controller(job: JudgeJob) -> RobotWalk:
     """Walk ``job``'s controller on its robot; its walk metrics, seed and furthest factor."""
     from imitwalk.sim.mujoco import make_plant, run
 
@@ -77,34 +101,35 @@ def run_controller(job: JudgeJob) -> dict:
         ref.trajectory(scale, job.seconds),
         ref.track(scale, ro.seconds),
     )
-    return {**m.to_dict(), "seed": job.seed, "furthest": job.furthest}
+    return RobotWalk(job.seed, job.furthest, m)
 
 
-def _side(runs: list[dict], factors) -> dict:
+def _side(runs: list[RobotWalk], factors) -> ControllerVerdict:
     n = len(runs)
-    falls = int(sum(r["fell"] for r in runs))
+    ms = [r.metrics for r in runs]
+    falls = int(sum(m.fell for m in ms))
     by = {f: 0 for f in factors}
     for r in runs:
-        if r["fell"] and r["furthest"] is not None:
-            by[r["furthest"]] = by.get(r["furthest"], 0) + 1
-    mean = lambda k: float(np.mean([r[k] for r in runs])) if runs else None  # noqa: E731
-    return {
-        "robots": n,
-        "survived": n - falls,
-        "falls": falls,
-        "survival": (n - falls) / n if n else 0.0,
-        "survival_ci95": list(wilson(n - falls, n)),
-        "distance_m": mean("forward_distance_m"),
-        "speed_mps": mean("forward_speed_mps"),
-        "abs_yaw_deg": float(np.mean([abs(r["yaw_drift_deg"]) for r in runs])) if runs else None,
-        "progress_ratio_min": float(min(r["progress_ratio"] for r in runs)) if runs else None,
-        "falls_by_furthest_factor": by,
-        "per_seed": [
-            {k: r[k] for k in ("seed", "fell", "fall_time_s", "forward_distance_m", "furthest")}
-            | {"yaw_drift_deg": r["yaw_drift_deg"]}
-            for r in runs
-        ],
-    }
+        if r.metrics.fell and r.furthest is not None:
+            by[r.furthest] = by.get(r.furthest, 0) + 1
+
+    def mean(xs) -> float | None:
+        return float(np.mean(xs)) if runs else None
+
+    lo, hi = wilson(n - falls, n)
+    return ControllerVerdict(
+        robots=n,
+        survived=n - falls,
+        falls=falls,
+        survival=(n - falls) / n if n else 0.0,
+        survival_ci95=(float(lo), float(hi)),
+        distance_m=mean([m.forward_distance_m for m in ms]),
+        speed_mps=mean([m.forward_speed_mps for m in ms]),
+        abs_yaw_deg=mean([abs(m.yaw_drift_deg) for m in ms]),
+        progress_ratio_min=float(min(m.progress_ratio for m in ms)) if runs else None,
+        falls_by_furthest_factor=by,
+        per_seed=tuple(r.row() for r in runs),
+    )
 
 
 def judge_protocol(
@@ -116,16 +141,10 @@ def judge_protocol(
     controllers: tuple[str, ...] | None = None,
     scale: float | None = None,
     workers: int | None = None,
-) -> dict:
+) -> ProtocolVerdict:
     """Every controller in ``controllers`` (``None``: every one the run can build) on
-    robots ``0 … seeds − 1`` of ``protocol``.
-
-    Returns:
-        ``{"protocol": …, "settings": …, "controllers": {name: side}, "comparison":
-        {name: McNemar vs open loop}}``; a side holds ``survived``, ``survival`` and its
-        ``survival_ci95``, ``distance_m``, ``speed_mps``, ``abs_yaw_deg``,
-        ``progress_ratio_min``, ``falls_by_furthest_factor`` and ``per_seed``.
-    """
+    robots ``0 … seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per controller,
+    and each one's falls compared with open loop's on the same robots (McNemar)."""
     metrics = RunDir(run_dir).read_json("metrics.json")
     loaded = _loaded(str(run_dir))
     valid = loaded.controllers()
@@ -155,21 +174,21 @@ def judge_protocol(
         c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
         for c in controllers
     }
-    out = {
-        "protocol": {"name": protocol.name, "version": protocol.version, "path": protocol.path},
-        "settings": {
-            "seeds": seeds,
-            "seconds": seconds,
-            "engine": protocol.engine,
-            "scale": scale if scale is not None else metrics.get("scale_reached"),
-            "controllers": list(controllers),
-        },
-        "controllers": {c: _side(runs, protocol.factors) for c, runs in by.items()},
-        "comparison": {},
-    }
+    comparison = {}
     if OPEN_LOOP in by:
-        base = [bool(r["fell"]) for r in by[OPEN_LOOP]]
+        base = [r.metrics.fell for r in by[OPEN_LOOP]]
         for c in controllers:
             if c != OPEN_LOOP:
-                out["comparison"][c] = compare_falls([bool(r["fell"]) for r in by[c]], base)
-    return out
+                comparison[c] = compare_falls([r.metrics.fell for r in by[c]], base)
+    return ProtocolVerdict(
+        protocol=ProtocolId(protocol.name, protocol.version, protocol.path),
+        settings=JudgeSettings(
+            seeds=seeds,
+            seconds=seconds,
+            engine=protocol.engine,
+            scale=scale if scale is not None else metrics.get("scale_reached"),
+            controllers=tuple(controllers),
+        ),
+        controllers={c: _side(runs, protocol.factors) for c, runs in by.items()},
+        comparison=comparison,
+    )

@@ -99,8 +99,8 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> _AmcValues:
         if bone.dof and len(rows.get(name, [])) != n:
             got = len(rows.get(name, []))
             raise MocapError(f"{src}: bone {name!r} of the ASF appears in {got} of {n} frames")
-    values = {k: np.array(v, dtype=float).reshape(n, -1) for k, v in rows.items()}
-    return _AmcValues(n, values, {k: np.array(v) for k, v in at.items()}, angle_scale)
+    arrays = {k: np.array(v, dtype=float).reshape(n, -1) for k, v in rows.items()}
+    return _AmcValues(n, arrays, {k: np.array(v) for k, v in at.items()}, angle_scale)
 
 
 def _forward_kinematics(skel: Skeleton, values: dict[str, np.ndarray], n: int, amc_scale: float):

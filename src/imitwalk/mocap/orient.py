@@ -83,7 +83,7 @@ def decide_up(top: np.ndarray, feet: np.ndarray, leg: float, src: str) -> tuple[
     rise = {a: float(np.median((top - feet.mean(axis=1)) @ e)) / leg for a, e in UP_VECTORS.items()}
     if not all(np.isfinite(r) for r in rise.values()):
         raise MocapError(f"{src}: cannot tell the up axis: the joint positions are not finite")
-    order = sorted(rise, key=rise.get, reverse=True)
+    order = sorted(rise, key=rise.__getitem__, reverse=True)
     best, second = order[0], order[1]
     if rise[best] < MIN_HEAD_LEGS:
         raise MocapError(

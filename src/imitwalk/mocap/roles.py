@@ -189,9 +189,9 @@ def leg_chains(joints: list[Joint], pos: np.ndarray) -> tuple[LegChain, LegChain
                 la, lb = lengths[a], lengths[b]
                 if a >= b or min(la, lb) <= 0 or abs(la - lb) > 0.1 * max(la, lb):
                     continue
-                legs = _chain(p, path(a), bone), _chain(p, path(b), bone)
-                if legs[0] and legs[1] and (best is None or la + lb > best[1]):
-                    best = (depth[p], la + lb, legs)
+                left, right = _chain(p, path(a), bone), _chain(p, path(b), bone)
+                if left and right and (best is None or la + lb > best[1]):
+                    best = (depth[p], la + lb, (left, right))
     return None if best is None else best[2]
 
 

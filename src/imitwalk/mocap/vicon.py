@@ -26,6 +26,7 @@ filled (:func:`imitwalk.mocap.gaps.fill_gaps`) and noted in ``Motion.filled``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -182,14 +183,22 @@ def read_c3d(
                 else _chord(lat, marker(f"{s}TIB"), kp[f"{k}_knee"], ankle_off)
             )
     kp["l_toe"], kp["r_toe"] = marker("LTOE"), marker("RTOE")
+
+    def mean(*roles: str) -> np.ndarray:
+        """The mean ``(T, 3)`` trajectory [mm] of these roles' markers (summed in order)."""
+        total = marker(roles[0])
+        for role in roles[1:]:
+            total = total + marker(role)
+        return total / len(roles)
+
     optional: dict[str, Callable[[], np.ndarray]] = {
-        "neck": lambda: (marker("C7") + marker("CLAV")) / 2,
-        "head": lambda: sum(marker(m) for m in ("LFHD", "RFHD", "LBHD", "RBHD")) / 4,
+        "neck": partial(mean, "C7", "CLAV"),
+        "head": partial(mean, "LFHD", "RFHD", "LBHD", "RBHD"),
     }
     for s in "LR":
-        optional[f"{s.lower()}_shoulder"] = lambda s=s: marker(f"{s}SHO")
-        optional[f"{s.lower()}_elbow"] = lambda s=s: marker(f"{s}ELB")
-        optional[f"{s.lower()}_wrist"] = lambda s=s: (marker(f"{s}WRA") + marker(f"{s}WRB")) / 2
+        optional[f"{s.lower()}_shoulder"] = partial(marker, f"{s}SHO")
+        optional[f"{s.lower()}_elbow"] = partial(marker, f"{s}ELB")
+        optional[f"{s.lower()}_wrist"] = partial(mean, f"{s}WRA", f"{s}WRB")
     missing = []
     for key, make in optional.items():
         try:

@@ -120,8 +120,8 @@ class GaitEmbedding(BaseEstimator):
         elif phase is not None:
             raise ValueError("phase is only used with phase_source='time'")
 
-        self.mean_ = X[:, :3].mean(axis=0)  # (3,)
-        Xc = X[:, :3] - self.mean_  # (T, 3)
+        self.mean_ = mean = X[:, :3].mean(axis=0)  # (3,)
+        Xc = X[:, :3] - mean  # (T, 3)
         z = rotation_axis(Xc)  # eq. (1)
         P = Xc - np.outer(Xc @ z, z)  # projection on the plane ⟂ z
         x = np.linalg.eigh(P.T @ P)[1][:, -1]  # maximal variance in that plane
@@ -130,11 +130,11 @@ class GaitEmbedding(BaseEstimator):
         x *= np.sign(x[np.argmax(np.abs(x))])  # deterministic sign
         y = np.cross(z, x)
         self.x_axis_, self.y_axis_, self.z_axis_ = x, y, z
-        self.basis_ = np.vstack([x, y, z])  # (3, 3) rows x_θ, y_θ, z_θ
+        self.basis_ = basis = np.vstack([x, y, z])  # (3, 3) rows x_θ, y_θ, z_θ
 
-        if timed:  # the loop point itself, (u, v, h), as a function of the time phase
+        if timed and phase is not None:  # the loop point, (u, v, h), against the time phase
             phi = TWO_PI * np.mod(phase, 1.0)
-            L = (X[:, :3] - self.mean_) @ self.basis_.T  # (T, 3) in the (x_θ, y_θ, z_θ) frame
+            L = (X[:, :3] - mean) @ basis.T  # (T, 3) in the (x_θ, y_θ, z_θ) frame
             T = np.column_stack([L, X[:, 3:]])  # (T, m)
         else:  # eq. (2): [r, h] as a function of the angle
             phi, r, h = self._cylinder(X)

@@ -8,6 +8,8 @@ judgement reports.
 
 from __future__ import annotations
 
+from typing import Any
+
 from scipy.stats import binomtest
 
 from imitwalk.paper.gait import GaitModel
@@ -67,7 +69,7 @@ def compare_falls(learned: list[bool], open_loop: list[bool]) -> dict:
     lo = sum(1 for a, b in zip(learned, open_loop, strict=True) if a and not b)
     oo = sum(1 for a, b in zip(learned, open_loop, strict=True) if b and not a)
     p = float(binomtest(lo, lo + oo, 0.5).pvalue) if lo + oo else 1.0
-    out = {"robots": n, "learned_only": lo, "open_only": oo, "mcnemar_p": p}
+    out: dict[str, Any] = {"robots": n, "learned_only": lo, "open_only": oo, "mcnemar_p": p}
     for name, fell in (("learned", learned), ("open_loop", open_loop)):
         k = int(sum(fell))
         out[f"{name}_fall_rate"] = k / n if n else 0.0

@@ -24,7 +24,7 @@ from imitwalk.paper.models import fit_model, stack_episodes, unstack_episodes
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
-from imitwalk.runs import RunDir
+from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.sim.perturb import train_seeds
 
 __all__ = ["FaithfulProgress", "learn"]
@@ -74,7 +74,7 @@ def _iteration_log(scale, it, results, report, t0) -> dict:
 
 def learn(
     ref: Reference, robot: Robot, config: LearnConfig, run_dir, resume: bool = False, progress=None
-) -> dict:
+) -> LearnSummary:
     """Learn to walk ``ref`` on ``robot`` as the paper does; write everything to ``run_dir``.
 
     Args:
@@ -144,18 +144,18 @@ def learn(
         rd.write_json("checkpoint.json", asdict(state))
         if progress:
             progress(_progress_line(entry))
-    summary = {
-        "learner": "faithful",
-        "variant": config.variant,
-        "scale_reached": max(state.passed) if state.passed else 0.0,
-        "scales_passed": state.passed,
-        "iterations": state.total_iterations,
-        "sim_seconds_used_for_learning": state.sim_seconds,
-        "wall_seconds_for_learning": state.wall_seconds,
-        "gait": gait.report(),
-        "config": asdict(config),
-    }
-    rd.write_json("metrics.json", summary)
+    summary = LearnSummary(
+        learner="faithful",
+        scale_reached=max(state.passed) if state.passed else 0.0,
+        scales_passed=state.passed,
+        iterations=state.total_iterations,
+        sim_seconds_used_for_learning=state.sim_seconds,
+        wall_seconds_for_learning=state.wall_seconds,
+        config=asdict(config),
+        variant=config.variant,
+        gait=gait.report(),
+    )
+    rd.write_json("metrics.json", summary.to_dict())
     return summary
 
 

@@ -42,7 +42,7 @@ def _mid_swing_ticks(stance: np.ndarray, phase_sigma: np.ndarray) -> list[tuple[
         for a, b in zip(starts, ends, strict=True):
             dist = np.abs(np.nan_to_num(phase_sigma[a:b, j], nan=np.inf) - 0.5)
             if np.isfinite(dist).any():
-                out.append((a + int(np.argmin(dist)), j))
+                out.append((int(a) + int(np.argmin(dist)), j))
     return out
 
 
@@ -84,8 +84,8 @@ def kinematic_checks(
         starts = np.flatnonzero(np.diff(c) == 1) + 1
         ends = np.flatnonzero(np.diff(c) == -1) + 1
         for a in starts:
-            b = ends[ends > a]
-            b = b[0] if len(b) else n
+            later = ends[ends > a]
+            b = int(later[0]) if len(later) else n
             xy = pos[a:b, j, :2]
             skate.append(float(np.linalg.norm(xy.max(0) - xy.min(0)) * 1000))
             landings.append((a, j, float(pos[a, j, 0])))

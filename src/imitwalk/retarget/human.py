@@ -41,13 +41,13 @@ def _human_sized(robot: Robot, k: dict) -> mujoco.MjModel:
         half_hip = _len(k, "l_hip", "r_hip") / 2
         m.body_pos[hip, 1] = np.sign(m.body_pos[hip, 1]) * half_hip
         for body, (a, b) in ((knee, ("hip", "knee")), (ankle, ("knee", "ankle"))):
-            robot_len = np.linalg.norm(m.body_pos[body])
+            robot_len = float(np.linalg.norm(m.body_pos[body]))
             m.body_pos[body] *= _len(k, f"{s}_{a}", f"{s}_{b}") / max(robot_len, 1e-6)
         if f"{s}_elbow" in robot.joint_names and f"{s}_elbow" in k:
             sh, el = _body(m, robot, f"{s}_shoulder_pitch"), _body(m, robot, f"{s}_elbow")
             m.body_pos[sh, 1] = np.sign(m.body_pos[sh, 1]) * _len(k, "l_shoulder", "r_shoulder") / 2
             m.body_pos[el] *= _len(k, f"{s}_shoulder", f"{s}_elbow") / max(
-                np.linalg.norm(m.body_pos[el]), 1e-6
+                float(np.linalg.norm(m.body_pos[el])), 1e-6
             )
     return m
 

@@ -154,7 +154,7 @@ def retarget(
     if cfg.mapping == "paper":
         ref = build_paper(motion, template, robot, cfg.scales, dt)
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
-        report = {}
+        report: dict = {}
     else:
         leg = leg_geometry(robot).leg
         check_side(cfg.command, leg)  # before any search: the sidestep scales with the leg
@@ -181,10 +181,10 @@ def retarget(
                     command=cfg.command,
                     progress=refine_progress,
                 )
-                if sc.refine_per_scale:
-                    own = out
-                else:
+                if isinstance(out, GaitParams):
                     params = out
+                else:
+                    own = out
         build = build_walkable(
             template, robot, params, cfg.scales, dt, command=cfg.command, scale_params=own
         )

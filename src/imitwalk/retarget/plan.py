@@ -260,6 +260,7 @@ def knee_cap(
     plan = plan_walk(
         template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None, command=command
     )
+    assert plan.path is not None and plan.yaw is not None  # plan_walk sets both
     reach = geom.leg * np.cos(np.radians(KNEE_MIN_DEG) / 2)
     c, s = np.cos(plan.path[:, 2]), np.sin(plan.path[:, 2])
     best = np.inf

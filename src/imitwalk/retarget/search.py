@@ -49,7 +49,8 @@ def bounds(leg: float | None) -> dict[str, tuple[float, float]]:
     """:data:`BOUNDS` for a robot whose leg (hip to ankle) is ``leg`` [m] (``None``: as
     written, for :data:`~imitwalk.retarget.params.REFERENCE_LEG`)."""
     return {
-        k: tuple(leg_scaled(x, leg) for x in v) if k in LENGTHS else v for k, v in BOUNDS.items()
+        k: (leg_scaled(v[0], leg), leg_scaled(v[1], leg)) if k in LENGTHS else v
+        for k, v in BOUNDS.items()
     }
 
 
@@ -97,6 +98,17 @@ class SearchConfig:
     def __post_init__(self):
         if self.engine not in ENGINES:
             raise unknown_name("engine", self.engine, ENGINES, ConfigError)
+        for name in ("generations", "population", "models"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"search_config.{name}: {getattr(self, name)} is below 1")
+        if not 1 <= self.elites <= self.population:
+            raise ConfigError(
+                f"search_config.elites: {self.elites} is not in 1..{self.population} (population)"
+            )
+        if not self.seconds > 0:
+            raise ConfigError(f"search_config.seconds: {self.seconds} is not above 0 s")
+        if not self.scales or not all(0.0 < x <= 1.0 for x in self.scales):
+            raise ConfigError(f"search_config.scales: {self.scales} must be scales in (0, 1]")
         if self.refine_rounds < 0:
             raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
         if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
@@ -192,6 +204,7 @@ def search_params(
             best = top
         if progress:
             progress(gen + 1, cfg.generations, best["score"], best["params"])
+    assert best is not None  # at least one generation ran
     per = len(cfg.scales) * cfg.models * cfg.seconds
     report = {
         "method": "cross-entropy method over open-loop rollouts",

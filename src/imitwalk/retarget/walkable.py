@@ -8,6 +8,7 @@ For every scale of a grid the stride is scaled in task space and the IK re-solve
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +44,7 @@ def build_walkable(
     template: GaitTemplate,
     robot: Robot,
     params: GaitParams,
-    scales: np.ndarray | list[float],
+    scales: Sequence[float] | np.ndarray,
     dt: float,
     ik: WalkIK | None = None,
     check_scale: float = 1.0,
@@ -83,6 +84,7 @@ def build_walkable(
         p = own.get(float(s), params)
         plan = plan_walk(template, geom, p, float(s), dt, cycles=2, start=True, command=command)
         res = ik.solve(plan)
+        assert plan.path is not None and plan.motion is not None  # plan_walk sets both
         frames += len(plan.phase)
         n_loop = round(plan.period / dt)
         m = len(plan.phase) - n_loop

@@ -82,7 +82,8 @@ def _servos(jm: JointMap, model, roles, joints, tree: Tree) -> tuple[ServoGains,
         a = acts.get(jid)
         kind = "none" if a is None else actuator_kind(model, a)
         is_leg = role is not None and role[2:5] in ("hip", "kne", "ank")
-        given = {**jm.servos.get("legs" if is_leg else "upper", {}), **jm.servos.get(role, {})}
+        own = {} if role is None else jm.servos.get(role, {})
+        given = {**jm.servos.get("legs" if is_leg else "upper", {}), **own}
         if role is None and kind != "motor":
             continue
         if kind == "other":
@@ -112,8 +113,8 @@ def _sole_pads(model, data, tree, side, sole, names) -> TouchPads:
     body = int(model.site_bodyid[sid]) if sid >= 0 else model.body(sole).id
     pos = tuple(model.site_pos[sid]) if sid >= 0 else (0.0, 0.0, 0.0)
     quat = tuple(model.site_quat[sid]) if sid >= 0 else (1.0, 0.0, 0.0, 0.0)
-    half = footprint(model, data, tree.subtree(body)).half
-    return TouchPads(model.body(body).name, pos, quat, tuple(float(x) for x in half), names)
+    hx, hy = footprint(model, data, tree.subtree(body)).half  # (2,) [m]
+    return TouchPads(model.body(body).name, pos, quat, (float(hx), float(hy)), names)
 
 
 def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf) -> tuple[Additions, Resolved]:

@@ -149,9 +149,9 @@ def _add_pads(spec: mujoco.MjSpec, pads: TouchPads) -> None:
     body = spec.body(pads.body)
     hx, hy = pads.size
     margin, thick = PAD_MARGIN * max(hx, hy), PAD_THICKNESS * hy
-    rot = np.zeros(9)
-    mujoco.mju_quat2Mat(rot, np.asarray(pads.quat, dtype=float))
-    rot = rot.reshape(3, 3)
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, np.asarray(pads.quat, dtype=float))
+    rot = mat.reshape(3, 3)
     half = [(hx + margin) / 2, (hy + margin) / 2, thick]
     for name, (sx, sy) in zip(pads.names, ((1, 1), (1, -1), (-1, 1), (-1, -1)), strict=True):
         centre = np.asarray(pads.pos) + rot @ np.array([sx * half[0], sy * half[1], 0.0])

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -25,6 +26,9 @@ from imitwalk.robots.roles import guess_roles
 from imitwalk.robots.servos import actuator_kind
 from imitwalk.robots.spec import LEG_ROLES, ROLES, Robot
 from imitwalk.robots.tree import Tree, footprint
+
+if TYPE_CHECKING:  # imitwalk.sim imports imitwalk.robots
+    from imitwalk.sim.standing import StandResult
 
 __all__ = ["CHECK_SECONDS", "Draft", "draft_joint_map"]
 
@@ -41,7 +45,7 @@ class Draft:
     jmap: dict
     lines: tuple[str, ...]
     robot: Robot
-    stand: object
+    stand: StandResult
 
 
 def _sole(tree: Tree, body: int, bodies: list[int]) -> dict | str:
@@ -147,11 +151,12 @@ def draft_joint_map(mjcf: str | Path, out: str | Path) -> Draft:
         if r in roles
     }
     rel = os.path.relpath(mjcf.resolve(), out.resolve().parent)
-    jmap = {"name": mjcf.stem, "mjcf": rel, "joints": joints, "torso": tree.name(sk.torso)}
+    jmap: dict[str, object] = {"name": mjcf.stem, "mjcf": rel, "joints": joints}
+    jmap["torso"] = tree.name(sk.torso)
     lines.append(f"guessed torso: {jmap['torso']}")
-    jmap["soles"] = {s: _sole(tree, *sk.feet[s]) for s in ("l", "r")}
+    jmap["soles"] = soles = {s: _sole(tree, *sk.feet[s]) for s in ("l", "r")}
     for s in ("l", "r"):
-        e = jmap["soles"][s]
+        e = soles[s]
         if isinstance(e, str):
             lines.append(f"guessed {s} sole: the site {e} (at the centre of the foot's geoms)")
             continue

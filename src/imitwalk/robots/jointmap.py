@@ -35,6 +35,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Final, Required, TypedDict
 
 from imitwalk.errors import RobotError, unknown_name
 
@@ -57,6 +58,8 @@ MAP_KEYS = (
 SERVO_GROUPS = ("legs", "upper")
 _SERVO_KEYS = ("kp", "kv", "torque_limit")
 _SIDES = ("l", "r")
+_KINDS: dict[type, str] = {list: "a list", dict: "an object"}
+_NAME_KEYS: Final = ("name", "mjcf", "gyro", "torso", "stand_keyframe")  # str-valued fields
 
 
 @dataclass(frozen=True)
@@ -88,6 +91,20 @@ class JointMap:
     stand_keyframe: str | None = None
     stand: dict[str, float] = field(default_factory=dict)
     servos: dict[str, dict[str, float]] = field(default_factory=dict)
+
+
+class _Fields(TypedDict, total=False):  # the JointMap fields a map sets (others: defaults)
+    soles: Required[dict[str, str | SoleSpec]]
+    name: str
+    mjcf: str
+    gyro: str
+    accelerometer: str | None
+    add_accelerometer: bool
+    foot_force: dict[str, tuple[str, ...]]
+    torso: str
+    stand_keyframe: str
+    stand: dict[str, float]
+    servos: dict[str, dict[str, float]]
 
 
 def load_joint_map(path: str | Path) -> dict:
@@ -161,7 +178,7 @@ def _kind(value) -> str:
         return f"the string {value[:40]!r}"
     if isinstance(value, int | float):
         return f"the number {value!r}"[:60]
-    return {list: "a list", dict: "an object"}.get(type(value), type(value).__name__)
+    return _KINDS.get(type(value), type(value).__name__)
 
 
 def _joint(role: str, entry, source: str) -> tuple[str, float]:
@@ -188,7 +205,7 @@ def _sole(side: str, entry, source: str) -> str | SoleSpec:
         if k not in ("body", "pos", "size", "quat"):
             raise unknown_name(f"key of {key}", k, ("body", "pos", "quat", "size"))
     body = _string(entry.get("body"), source, f"{key}.body")
-    vec = {}
+    vec: dict[str, tuple[float, ...]] = {}
     for k, n, positive in (("pos", 3, False), ("size", 2, True), ("quat", 4, False)):
         if k == "quat" and k not in entry:
             continue
@@ -200,7 +217,8 @@ def _sole(side: str, entry, source: str) -> str | SoleSpec:
     norm = math.sqrt(sum(x * x for x in quat))
     if not 1e-6 < norm < 1e6:
         raise RobotError(f"{_where(source, f'{key}.quat')} must be a non-zero quaternion")
-    return SoleSpec(body, vec["pos"], vec["size"], tuple(x / norm for x in quat))
+    (px, py, pz), (hx, hy), (qw, qx, qy, qz) = vec["pos"], vec["size"], (q / norm for q in quat)
+    return SoleSpec(body, (px, py, pz), (hx, hy), (qw, qx, qy, qz))
 
 
 def parse_joint_map(data: dict, source: str = "") -> JointMap:
@@ -236,10 +254,10 @@ def parse_joint_map(data: dict, source: str = "") -> JointMap:
     for side in _SIDES:
         if side not in soles:
             raise RobotError(f"{_where(src, 'soles')} has no {side!r} sole")
-    out = {"soles": {s: _sole(s, soles[s], src) for s in _SIDES}}
-    for key in ("name", "mjcf", "gyro", "torso", "stand_keyframe"):
-        if key in data:
-            out[key] = _string(data[key], src, key)
+    out: _Fields = {"soles": {s: _sole(s, soles[s], src) for s in _SIDES}}
+    for name_key in _NAME_KEYS:
+        if name_key in data:
+            out[name_key] = _string(data[name_key], src, name_key)
     if "accelerometer" in data:
         acc = data["accelerometer"]
         out["accelerometer"] = None if acc is None else _string(acc, src, "accelerometer")

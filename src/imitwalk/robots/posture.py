@@ -48,7 +48,7 @@ def solve_stand(
     d = cfg.data
     mujoco.mj_kinematics(m, d)
     root = int(m.body_rootid[m.body(robot.torso).id])
-    tasks = []
+    tasks: list[mink.Task] = []
     mid = np.zeros(3)
     for s in ("l", "r"):
         name = robot.soles[s]

@@ -153,7 +153,9 @@ def _arm(tree: Tree, sk: Skeleton, side: str, leaf: int) -> None:
         if after and np.linalg.norm(forearm) > 1e-6:
             j = after[0]
             a = tree.data.xaxis[j]
-            along = float(a @ forearm) / np.linalg.norm(forearm) / max(np.linalg.norm(a), 1e-12)
+            along = (
+                float(a @ forearm) / np.linalg.norm(forearm) / max(float(np.linalg.norm(a)), 1e-12)
+            )
             if abs(along) > 0.9:
                 sign = -1.0 if along > 0 else 1.0  # positive: as a yaw of the hanging arm
                 note = f"turns about the {word} forearm"

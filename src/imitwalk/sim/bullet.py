@@ -132,7 +132,7 @@ class BulletPlant:
         self._queue = ServoQueue(self._cmd.copy(), opt.delay_steps(1.0 / self.dt))
         self._steps = self._kicks = 0
         self._accel = np.zeros(3)
-        self._imu_now = (np.zeros(3), np.zeros(3), np.eye(3))  # set by reset() and step()
+        self._imu_now: tuple[np.ndarray, ...] = (np.zeros(3), np.zeros(3), np.eye(3))  # (v, ω, R)
         self.time = 0.0
         self.fell = False
         self.fall_time: float | None = None

@@ -17,7 +17,7 @@ an initial twist.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import mujoco
 import numpy as np
@@ -34,6 +34,9 @@ from imitwalk.sim.types import (
     jitter_draws,
     kicks_due,
 )
+
+if TYPE_CHECKING:
+    from imitwalk.sim.bullet import BulletPlant
 
 __all__ = [
     "ENGINES",
@@ -228,7 +231,7 @@ Policy = Callable[[int, Observation], np.ndarray]
 
 
 def run(
-    plant: Plant,
+    plant: MujocoPlant | BulletPlant,
     policy: Policy,
     steps: int,
     q0: np.ndarray | None = None,
@@ -252,28 +255,14 @@ def run(
     obs = plant.reset(q0)
     n, nq = len(plant.joint_names), plant.nq
     keys = ("t", "q_cmd", "q", "gyro", "accel", "ff", "pos", "quat", "qpos", "torque")
-    rec = {k: [] for k in keys}
+    rec: dict[str, list[object]] = {k: [] for k in keys}
     for k in range(steps):
         target = np.asarray(policy(k, obs), dtype=float)
         plant.command(target)
         obs = plant.step()
         pos, quat = plant.torso_pose()
-        for key, val in zip(
-            rec,
-            (
-                obs.t,
-                plant.commanded,
-                obs.joints,
-                obs.gyro,
-                obs.accel,
-                obs.foot_force,
-                pos,
-                quat,
-                plant.qpos(),
-                plant.torques(),
-            ),
-            strict=True,
-        ):
+        row = (obs.t, plant.commanded, obs.joints, obs.gyro, obs.accel, obs.foot_force, pos, quat)
+        for key, val in zip(rec, (*row, plant.qpos(), plant.torques()), strict=True):
             rec[key].append(val)
         if plant.fell and stop_on_fall:
             break
@@ -299,7 +288,7 @@ def run(
 
 
 def playback(
-    plant: Plant,
+    plant: MujocoPlant | BulletPlant,
     targets: np.ndarray,
     q0: np.ndarray | None = None,
     stop_on_fall: bool = True,

@@ -121,7 +121,8 @@ def trial_seeds(
     while None in bands:
         seed += 1
         f = perturbed(seed, disturbance=True, friction_range=(lo, hi)).friction
+        assert f is not None  # a perturbed seed (not 0) always draws a friction
         band = min(int((f - lo) / (hi - lo) * (n - 1)), n - 2)
         if bands[band] is None:
             bands[band] = seed
-    return (0, *sorted(bands))
+    return (0, *sorted(b for b in bands if b is not None))  # every band is filled

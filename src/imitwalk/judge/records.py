@@ -1,0 +1,190 @@
+"""Typed records of a protocol's judgement (pure Python).
+
+:func:`imitwalk.judge.verdict.judge_protocol` returns a :class:`ProtocolVerdict`; its
+:meth:`~ProtocolVerdict.to_dict` is the JSON that ``imitwalk evaluate`` prints and writes
+as ``protocol_NAME.json``, and :meth:`~ProtocolVerdict.from_dict` reads such a file back
+(the report's tables do). :func:`imitwalk.judge.pushes.push_recovery` returns a
+:class:`PushVerdict`, written as ``push_recovery.json``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+__all__ = [
+    "ControllerVerdict",
+    "JudgeSettings",
+    "ProtocolId",
+    "ProtocolVerdict",
+    "PushSettings",
+    "PushSide",
+    "PushVerdict",
+    "SeedRow",
+]
+
+
+@dataclass(frozen=True)
+class SeedRow:
+    """One robot's walk under one controller.
+
+    Attributes:
+        seed: the protocol's robot; fell: it fell; fall_time_s: when [s] (``None``: it did
+        not); forward_distance_m: torso travel along the heading [m]; furthest: the factor
+        the robot drew furthest from nominal; yaw_drift_deg: heading change beyond the
+        commanded turn [deg].
+    """
+
+    seed: int
+    fell: bool
+    fall_time_s: float | None
+    forward_distance_m: float
+    furthest: str | None
+    yaw_drift_deg: float
+
+
+@dataclass(frozen=True)
+class ControllerVerdict:
+    """One controller on every robot of a protocol.
+
+    Attributes:
+        robots, survived, falls: counts; survival: survived ÷ robots, with its 95 % Wilson
+        interval ``survival_ci95``; distance_m [m], speed_mps [m/s], abs_yaw_deg [deg]:
+        means over the robots (``None`` for none); progress_ratio_min: the slowest robot's;
+        falls_by_furthest_factor: falls counted under the factor each robot drew furthest
+        from nominal; per_seed: the robots' rows, in seed order.
+    """
+
+    robots: int
+    survived: int
+    falls: int
+    survival: float
+    survival_ci95: tuple[float, float]
+    distance_m: float | None
+    speed_mps: float | None
+    abs_yaw_deg: float | None
+    progress_ratio_min: float | None
+    falls_by_furthest_factor: dict[str, int]
+    per_seed: tuple[SeedRow, ...]
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        out = asdict(self)
+        out["survival_ci95"] = list(self.survival_ci95)
+        out["per_seed"] = [asdict(r) for r in self.per_seed]
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict) -> ControllerVerdict:
+        """The record :meth:`to_dict` wrote."""
+        rows = tuple(SeedRow(**{f.name: r[f.name] for f in fields(SeedRow)}) for r in d["per_seed"])
+        lo, hi = d["survival_ci95"]
+        own = {f.name: d[f.name] for f in fields(cls)}
+        return cls(**{**own, "survival_ci95": (float(lo), float(hi)), "per_seed": rows})
+
+
+@dataclass(frozen=True)
+class ProtocolId:
+    """Which protocol: its name, version, and where it came from (a built-in's name, or
+    its file's path)."""
+
+    name: str
+    version: int
+    path: str = ""
+
+
+@dataclass(frozen=True)
+class JudgeSettings:
+    """How it was judged: robots, seconds per robot [s], engine, stride scale, and the
+    controllers asked for, in order."""
+
+    seeds: int
+    seconds: float
+    engine: str
+    scale: float | None
+    controllers: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ProtocolVerdict:
+    """Every controller of a run on the same robots of a protocol.
+
+    Attributes:
+        protocol, settings: what was judged and how; controllers: name → its verdict;
+        comparison: name → the paired comparison of its falls with open loop's
+        (:func:`imitwalk.paper.evaluate.compare_falls`; empty without open loop).
+    """
+
+    protocol: ProtocolId
+    settings: JudgeSettings
+    controllers: dict[str, ControllerVerdict]
+    comparison: dict[str, dict]
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary (the layout of ``protocol_NAME.json``)."""
+        settings = asdict(self.settings)
+        settings["controllers"] = list(self.settings.controllers)
+        return {
+            "protocol": asdict(self.protocol),
+            "settings": settings,
+            "controllers": {c: v.to_dict() for c, v in self.controllers.items()},
+            "comparison": dict(self.comparison),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> ProtocolVerdict:
+        """The record :meth:`to_dict` wrote."""
+        st = d["settings"]
+        return cls(
+            protocol=ProtocolId(**d["protocol"]),
+            settings=JudgeSettings(**{**st, "controllers": tuple(st["controllers"])}),
+            controllers={c: ControllerVerdict.from_dict(v) for c, v in d["controllers"].items()},
+            comparison=dict(d.get("comparison", {})),
+        )
+
+
+@dataclass(frozen=True)
+class PushSettings:
+    """How push recovery was measured: the stride scale, phases per gait cycle, kick
+    directions, how long the robot must stay up after a kick [s], the largest kick tried
+    and the bisection's resolution [m/s], and each phase's kick time [s]."""
+
+    scale: float
+    phases: int
+    directions: tuple[str, ...]
+    after_s: float
+    top_mps: float
+    resolution_mps: float
+    kick_times_s: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class PushSide:
+    """One controller's push recovery: the largest kick survived [m/s] per direction and
+    phase (``table``), the least per direction, and the mean of the table."""
+
+    table: dict[str, list[float]]
+    min_by_direction: dict[str, float]
+    mean: float
+
+
+@dataclass(frozen=True)
+class PushVerdict:
+    """Push recovery of every controller of a run
+    (:func:`imitwalk.judge.pushes.push_recovery`); JSON as ``push_recovery.json``."""
+
+    settings: PushSettings
+    controllers: dict[str, PushSide]
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        st = asdict(self.settings)
+        st["directions"], st["kick_times_s"] = list(st["directions"]), list(st["kick_times_s"])
+        return {"settings": st, "controllers": {c: asdict(v) for c, v in self.controllers.items()}}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> PushVerdict:
+        """The record :meth:`to_dict` wrote."""
+        st = d["settings"]
+        tuples = {k: tuple(st[k]) for k in ("directions", "kick_times_s")}
+        settings = PushSettings(**{**st, **tuples})
+        return cls(settings, {c: PushSide(**v) for c, v in d["controllers"].items()})
