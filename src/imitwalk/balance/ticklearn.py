@@ -6,8 +6,7 @@ and ends where an uninterrupted one would:
 1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
    roll, heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
    chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
-   many short walks of training robots. This is the baseline; the learned law starts
-   from it.
+   many short walks of training robots: the baseline the learned law starts from.
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.balance.tickmodel.PhaseModel`), turn it into gains by
@@ -19,9 +18,8 @@ and ends where an uninterrupted one would:
    trial-picked law alone).
 
 ``scale_reached`` is the top scale if the kept law walked every trial robot there without
-a fall, else the highest scale the schedule passed (the first if none): the run's
-controllers are judged there. ``scales_passed`` says how far the schedule carried the
-model-based law.
+a fall, else the highest scale the schedule passed (the first if none): the controllers
+are judged there. ``scales_passed``: how far the schedule carried the model-based law.
 
 Training robots come from ``train_protocol`` with seeds no evaluation uses.
 """

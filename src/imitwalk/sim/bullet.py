@@ -1,27 +1,25 @@
 """A second physics engine: the same robot, servos and sensors on PyBullet.
 
 :class:`BulletPlant` implements :class:`imitwalk.sim.mujoco.Plant` on Bullet (the ``pybullet``
-wheel, already a dependency for the default clip), so a reference or a controller
-learned on MuJoCo can be played, unchanged, on another engine's contact model and
-integrator (``imitwalk evaluate RUN --engine bullet``), and the whole method can be run
-on it (``imitwalk learn --set engine=bullet --set retarget.search_config.engine=bullet``).
+wheel, already a dependency for the default clip): a reference or a controller learned on
+MuJoCo plays unchanged on another contact model and integrator (``imitwalk evaluate RUN
+--protocol bullet``), and the whole method runs on it (``--set engine=bullet``).
 
 The robot is the MuJoCo model written out as URDF (:func:`imitwalk.robots.urdf.to_urdf`):
 the same masses, inertias, joint axes, ranges and collision shapes. The servos are the
-MJCF's position actuators, with ``kp``, ``kv``, the joint damping and the torque limit read
-from the compiled model, applied as torques at 5 kHz and integrated implicitly, one joint
-at a time (:class:`imitwalk.sim.servo.StablePD`: Bullet has no rotor inertia, and an explicit PD
-diverges on the light links). Joint friction loss is left out.
-
-The sensors are the robot's: the gyro at its site; the accelerometer at the same site,
-from the site's velocity change over the control period (averaged over 10 ms, where
-MuJoCo's is instantaneous); each sole's touch sensors as the normal force of the
-contacts inside the sensor's box, as MuJoCo's ``touch`` sensor does. The perturbations
-of :class:`~imitwalk.sim.types.SimOptions` are applied with the same random draws as
+MJCF's position actuators (``kp``, ``kv``, joint damping, torque limit), applied as torques
+at 5 kHz and integrated implicitly joint by joint (:class:`imitwalk.sim.servo.StablePD`:
+Bullet has no rotor inertia, and an explicit PD diverges on light links); joint friction
+loss is left out. The gyro is read at its site; the accelerometer there from the site's
+velocity change over the control period (a 10 ms mean, where MuJoCo's is instantaneous);
+each touch sensor as the normal force of the contacts inside its box, as MuJoCo's. The
+perturbations of :class:`~imitwalk.sim.types.SimOptions` use the same random draws as
 :class:`~imitwalk.sim.mujoco.MujocoPlant`, so seed ``s`` is the same robot.
 """
 
 from __future__ import annotations
+
+import contextlib
 
 import numpy as np
 import pybullet as pb
@@ -138,10 +136,8 @@ class BulletPlant:
         self.fall_time: float | None = None
 
     def __del__(self):
-        try:
+        with contextlib.suppress(Exception):  # already gone at interpreter exit
             pb.disconnect(self.client)
-        except Exception:  # already gone at interpreter exit
-            pass
 
     # -- geometry --------------------------------------------------------------
     def _frame(self, link: int) -> tuple[np.ndarray, np.ndarray, tuple]:
@@ -183,8 +179,7 @@ class BulletPlant:
         qpos = self._stand_qpos.copy()
         q = r.stand if q is None else np.asarray(q, dtype=float)
         qpos[self._qadr] = q * self._sign
-        w, x, y, z = qpos[3:7]
-        orn = [x, y, z, w]
+        orn = [*qpos[4:7], qpos[3]]  # (x, y, z, w)
         self._place_base([0.0, 0.0, 0.0], orn)
         angles = np.r_[qpos[self._qadr], self._held_target]
         for i, angle in zip(self._dof + self._held, angles, strict=True):
@@ -193,9 +188,7 @@ class BulletPlant:
         for link, off, _ in self._soles:
             pos, rot, _ = self._frame(link)
             low = min(low, (pos + rot @ off)[2])
-        base = qpos[:3].copy()
-        base[2] = -low + 1e-4
-        self._place_base(base.tolist(), orn)
+        self._place_base([*qpos[:2], -low + 1e-4], orn)
         tw = np.asarray(opt.init_twist, dtype=float)  # angular part in the base's frame
         lin, ang = tw[:3].tolist(), (_rot(orn) @ tw[3:]).tolist()
         pb.resetBaseVelocity(self.body, lin, ang, physicsClientId=c)
@@ -222,8 +215,7 @@ class BulletPlant:
         mjj = mass[6 + np.array(dofs)]  # each joint's own inertia [kg m²]
         for _ in range(self.substeps):
             states = pb.getJointStates(self.body, dofs, physicsClientId=c)
-            q = np.array([s[0] for s in states])
-            qd = np.array([s[1] for s in states])
+            q, qd = np.array([s[:2] for s in states]).T  # angles, velocities
             target = np.r_[self._queue.applied(self._steps) * self._sign, self._held_target]
             tau = self.servo.torque(target, q, qd, mjj).tolist()
             pb.setJointMotorControlArray(self.body, dofs, pb.TORQUE_CONTROL, forces=tau, **cid)
@@ -281,8 +273,7 @@ class BulletPlant:
         """The MuJoCo ``qpos`` of this state (for rendering a Bullet run with MuJoCo)."""
         pos, _, orn = self._frame(-1)
         out = self._stand_qpos.copy()
-        out[:3] = pos
-        out[3:7] = [orn[3], orn[0], orn[1], orn[2]]
+        out[:7] = [*pos, orn[3], orn[0], orn[1], orn[2]]
         out[self._qadr] = self.joints() * self._sign
         return out
 
