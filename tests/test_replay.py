@@ -28,7 +28,7 @@ def test_a_per_tick_run_builds_learned_feedback_fixed_and_open_loop(tick_run, ro
     m = RunDir(tick_run).read_json("metrics.json")
     assert lr.learner == "tick" and lr.engine == "mujoco" and lr.gait is None
     assert lr.controllers() == ("learned", "feedback", "fixed", OPEN_LOOP)
-    assert lr.scale == m["scale_reached"] and lr.metrics == m
+    assert lr.scale == m["scale_reached"] and lr.metrics.to_dict() == m
     for name in ("learned", "feedback", "fixed"):
         policy = lr.policy(name, robot, seconds=4.0)
         assert isinstance(policy, TickPolicy) and policy.laws == lr.laws[name]
@@ -63,9 +63,22 @@ def test_a_faithful_run_builds_the_papers_controller(faithful_run, robot):
     policy = lr.policy("learned", robot, scale=0.4)
     assert isinstance(policy, WalkPolicy) and policy.scale == 0.4
     assert policy.selector is not None  # the search of eqs. 5-13 with the fitted model
-    assert lr.scale == (lr.metrics["scale_reached"] or 0.3)
+    assert lr.scale == (lr.metrics.scale_reached or 0.3)
 
 
 def test_a_folder_that_is_not_a_run_is_said_in_one_line(tmp_path):
     with pytest.raises(RunError, match=r"config\.json not found: is .* a finished imitwalk run"):
         load_run(tmp_path)
+
+
+def test_an_incomplete_metrics_file_is_a_one_line_error(tmp_path, capsys):
+    from imitwalk.cli.main import main
+
+    rd = RunDir(tmp_path)
+    rd.write_json("config.json", {"learner": "tick", "learn": {}})
+    rd.write_json("metrics.json", {"learner": "tick", "scale_reached": 1.0})
+    with pytest.raises(RunError, match=r"metrics\.json lacks scales_passed, iterations"):
+        load_run(tmp_path)
+    assert main(["evaluate", str(tmp_path), "--seeds", "1", "--seconds", "1"]) == 2
+    errors = [x for x in capsys.readouterr().err.splitlines() if x.startswith("error:")]
+    assert len(errors) == 1 and "lacks" in errors[0] and not rd.exists("protocol_eval.json")

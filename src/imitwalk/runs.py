@@ -75,8 +75,13 @@ class LearnSummary:
         return {k: v for k, v in asdict(self).items() if k not in other}
 
     @classmethod
-    def from_dict(cls, d: dict) -> LearnSummary:
-        """The record :meth:`to_dict` wrote (``metrics.json``)."""
+    def from_dict(cls, d: dict, where: str = "metrics.json") -> LearnSummary:
+        """The record :meth:`to_dict` wrote; :class:`RunError` naming the missing keys
+        if ``d`` (read from ``where``) lacks any."""
+        required = [f.name for f in fields(cls) if f.name not in (*_TICK_ONLY, *_FAITHFUL_ONLY)]
+        missing = [k for k in required if not isinstance(d, dict) or k not in d]
+        if missing:
+            raise RunError(f"{where} lacks {', '.join(missing)}: not a finished imitwalk run")
         return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
 
 
@@ -111,6 +116,13 @@ class RunDir:
         """Write ``obj`` as JSON atomically."""
         text = json.dumps(obj, indent=2, default=_json_default)
         return atomic_write(self.file(name), lambda tmp: tmp.write_text(text + "\n"))
+
+    def read_summary(self) -> LearnSummary:
+        """The run's ``metrics.json`` as a :class:`LearnSummary` (a one-line
+        :class:`RunError` if it is missing, broken or incomplete)."""
+        return LearnSummary.from_dict(
+            self.read_json("metrics.json"), str(self.file("metrics.json"))
+        )
 
     def read_json(self, name: str):
         """Read a JSON file; :class:`RunError` if missing or broken."""

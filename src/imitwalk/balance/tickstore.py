@@ -10,6 +10,7 @@ import numpy as np
 from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.config import from_dict
+from imitwalk.errors import RunError
 from imitwalk.runs import RunDir
 
 __all__ = [
@@ -77,14 +78,16 @@ def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
     trial-picked law), ``learned`` (with the kept fraction of the model-based law on top)
     and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""
     rd = RunDir(run_dir)
-    metrics = rd.read_json("metrics.json")
+    metrics = rd.read_summary()
     cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
-    base = feedback_law(cfg, metrics["feedback_gains"])
+    if metrics.feedback_gains is None:
+        raise RunError(f"{rd.file('metrics.json')} has no feedback_gains: not a per-tick run")
+    base = feedback_law(cfg, metrics.feedback_gains)
     fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
         "ankle_pitch", "gyro_y", 0.05
     )
     learned: tuple[FeedbackLaw, ...] = (base,)
-    frac = float(metrics.get("trust") or 0.0)
+    frac = float(metrics.trust or 0.0)
     law = load_learned(rd)
     if frac > 0 and law is not None:
         learned = (base, replace(law, gains=law.gains * frac))

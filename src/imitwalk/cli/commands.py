@@ -269,7 +269,7 @@ def report(args: argparse.Namespace) -> int:
     from imitwalk.runs import RunDir
 
     rd = RunDir(args.run_dir)
-    rd.read_json("metrics.json")  # a clear error if this is not a finished run
+    rd.read_summary()  # a clear error if this is not a finished run
     robot = None
     if args.robot:
         robot = robot_from(args)

@@ -16,7 +16,9 @@ import numpy as np
 
 from imitwalk.evidence import curves, plots
 from imitwalk.fileio import atomic_write
+from imitwalk.judge.replay import LoadedRun
 from imitwalk.robots import Robot
+from imitwalk.runs import LearnSummary
 from imitwalk.sim.mujoco import MujocoPlant, Rollout, SimOptions, make_plant, run
 
 __all__ = [
@@ -71,16 +73,16 @@ def outcome(ro: Rollout) -> str:
     return f"{fell}; torso moved {d[0]:+.2f} m along x, {d[1]:+.2f} m along y in {ro.seconds:.1f} s"
 
 
-def summary_phrase(metrics: dict) -> str:
-    """What a run's ``metrics.json`` kept, in a phrase: a per-tick run's trial-picked
-    gains and the fraction of its model-based law; a faithful run's scales."""
-    gains = metrics.get("feedback_gains")
+def summary_phrase(metrics: LearnSummary) -> str:
+    """What a run kept, in a phrase: a per-tick run's trial-picked gains and the fraction
+    of its model-based law; a faithful run's iterations."""
+    gains = metrics.feedback_gains
     if gains is None:
-        return f"{metrics.get('iterations')} iterations of the paper's learner"
+        return f"{metrics.iterations} iterations of the paper's learner"
     names = {"pitch": "gyro_y → ankle pitch", "roll": "gyro_x → ankle roll",
              "heading": "heading → turn"}  # fmt: skip
     kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
-    trust = metrics.get("trust")
+    trust = metrics.trust
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"
     return f"trial-picked gains {kept}{learned}"
 
@@ -191,7 +193,7 @@ class Replays:
         return [("before: open loop", self.before), ("after: learned", self.after)]
 
 
-def replay(run_, robot: Robot, seconds: float, scale: float | None = None, options=None):
+def replay(run_: LoadedRun, robot: Robot, seconds: float, scale: float | None = None, options=None):
     """Run the open-loop reference and the learned controller of a loaded run
     (:func:`~imitwalk.judge.replay.load_run`) for ``seconds`` [s] at ``scale`` (default: the
     scale reached) on the engine it learned on, without stopping at a fall; ``options``:
@@ -213,7 +215,7 @@ def replay(run_, robot: Robot, seconds: float, scale: float | None = None, optio
     return Replays(scale, before, after, actions)
 
 
-def kick_strip(renderer, run_, robot: Robot, count: int):
+def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int):
     """One kick, rendered: the learned controller on the nominal robot kicked to the left
     at the left heel strike two cycles after the start-up, by half the hard protocol's
     largest kick; ``count`` images over the 1.5 s after it. Returns (figure, caption)."""

@@ -22,7 +22,7 @@ from imitwalk.evidence import curves, media, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.judge import tables
 from imitwalk.judge.records import ProtocolVerdict, PushVerdict
-from imitwalk.judge.replay import load_run
+from imitwalk.judge.replay import LoadedRun, load_run
 from imitwalk.paper.gait import GaitConfig, GaitModel
 from imitwalk.robots import Robot, load_robot
 from imitwalk.runs import RunDir
@@ -132,7 +132,7 @@ def write_report(
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}'
         f'</title><link rel="icon" href="data:,"><style>{STYLE}</style></head><body>\n'
         f"<h1>{title}</h1>\n<p>{html.escape(lg.learner)} learner; scale "
-        f"reached {lg.scale:g}; {m.get('iterations')} learning iterations; report made in "
+        f"reached {lg.scale:g}; {m.iterations} learning iterations; report made in "
         f"{time.perf_counter() - t0:.0f} s.</p>\n{body}</body></html>\n"
     )
     out = atomic_write(rd.file("report.html"), lambda tmp: tmp.write_text(page, "utf-8"))
@@ -161,13 +161,13 @@ def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
     )
 
 
-def _display_gait(lg) -> GaitModel:
+def _display_gait(lg: LoadedRun) -> GaitModel:
     """The paper's representation of the run's reference, for Figs. 3, 4, 6 and 7: the
     faithful run's own; for a per-tick run, the paper's (k = 3, the angle as the phase)
     over the schedule's scales."""
     if lg.gait is not None:
         return lg.gait.gait
-    cfg = lg.metrics.get("config", {})
+    cfg = lg.metrics.config
     start, step = float(cfg.get("start", 0.3)), float(cfg.get("step", 0.1))
     n = int(round((lg.scale - start) / step)) + 1 if lg.scale >= start else 1
     scales = sorted({round(start + i * step, 6) for i in range(max(n, 1))} | {lg.scale})
@@ -199,10 +199,10 @@ def _robustness(rd: RunDir, kick: tuple) -> str:
 
 
 def _sections(
-    rd: RunDir, lg, gait, rp: media.Replays, config: dict, video, fig8, poses, ticks, kick
+    rd: RunDir, lg: LoadedRun, gait, rp: media.Replays, config, video, fig8, poses, ticks, kick
 ) -> str:
     scale, log, m = rp.scale, rd.read_log(), lg.metrics
-    passed = [float(p) for p in m.get("scales_passed", [])]
+    passed = [float(p) for p in m.scales_passed]
     at_final = bool(passed) and abs(lg.scale - scale) < 1e-9
     evr = gait.subspace.explained_variance_ratio_
     gyro = curves.gyro_traces(
@@ -241,7 +241,7 @@ def _sections(
             "Learning",
             _figure(
                 _img(learning, "learning curves"),
-                f"{m.get('iterations')} iterations; {m.get('sim_seconds_used_for_learning'):.0f} "
+                f"{m.iterations} iterations; {m.sim_seconds_used_for_learning:.0f} "
                 f"s simulated; scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}; "
                 f"{html.escape(media.summary_phrase(m))}.",
             ),

@@ -16,7 +16,7 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.retarget.reference import Reference
-from imitwalk.runs import RunDir
+from imitwalk.runs import LearnSummary, RunDir
 
 if TYPE_CHECKING:
     from imitwalk.paper.evaluate import LearnedGait
@@ -45,7 +45,8 @@ class LoadedRun:
     Attributes:
         path: its folder; learner: ``"tick"`` or ``"faithful"``; ref: its reference;
         scale: the scale it reached; engine: the engine it learned on; metrics: its
-        ``metrics.json``; laws: the per-tick run's feedback laws by controller name;
+        ``metrics.json`` (a :class:`~imitwalk.runs.LearnSummary`); laws: the per-tick
+        run's feedback laws by controller name;
         gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`).
     """
 
@@ -54,7 +55,7 @@ class LoadedRun:
     ref: Reference
     scale: float
     engine: str
-    metrics: dict
+    metrics: LearnSummary
     laws: dict | None = None
     gait: LearnedGait | None = None
 
@@ -103,13 +104,13 @@ def load_run(run_dir) -> LoadedRun:
     """Read a finished run folder (a one-line :class:`~imitwalk.errors.RunError` if it is
     not one)."""
     rd = RunDir(run_dir)
-    config, metrics = rd.read_json("config.json"), rd.read_json("metrics.json")
+    config, metrics = rd.read_json("config.json"), rd.read_summary()
     engine = str(config.get("learn", {}).get("engine", "mujoco"))
     if config.get("learner") == "tick":
         from imitwalk.balance.tickstore import load_laws
 
         ref = Reference.load(rd.file("reference.npz"))
-        scale = float(metrics["scale_reached"])
+        scale = float(metrics.scale_reached)
         return LoadedRun(str(rd.path), "tick", ref, scale, engine, metrics, laws=load_laws(rd.path))
     from imitwalk.paper.evaluate import load_gait
 

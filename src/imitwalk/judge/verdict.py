@@ -78,7 +78,10 @@ _CACHE: dict[tuple[str, int], LoadedRun] = {}
 
 
 def _loaded(run_dir: str) -> LoadedRun:
-    key = (run_dir, RunDir(run_dir).file("metrics.json").stat().st_mtime_ns)
+    rd = RunDir(run_dir)
+    if not rd.exists("metrics.json"):
+        rd.read_summary()  # the one-line RunError of a folder that is not a finished run
+    key = (run_dir, rd.file("metrics.json").stat().st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
         _CACHE[key] = load_run(run_dir)
@@ -145,7 +148,6 @@ def judge_protocol(
     """Every controller in ``controllers`` (``None``: every one the run can build) on
     robots ``0 … seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per controller,
     and each one's falls compared with open loop's on the same robots (McNemar)."""
-    metrics = RunDir(run_dir).read_json("metrics.json")
     loaded = _loaded(str(run_dir))
     valid = loaded.controllers()
     controllers = valid if controllers is None else tuple(controllers)
@@ -186,7 +188,7 @@ def judge_protocol(
             seeds=seeds,
             seconds=seconds,
             engine=protocol.engine,
-            scale=scale if scale is not None else metrics.get("scale_reached"),
+            scale=scale if scale is not None else loaded.metrics.scale_reached,
             controllers=tuple(controllers),
         ),
         controllers={c: _side(runs, protocol.factors) for c, runs in by.items()},

@@ -16,7 +16,7 @@ from imitwalk.paper.gait import GaitModel
 from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.paper.models import build_policy, fit_model, unstack_episodes
 from imitwalk.retarget.reference import Reference
-from imitwalk.runs import RunDir
+from imitwalk.runs import LearnSummary, RunDir
 
 __all__ = ["LearnedGait", "compare_falls", "load_gait", "wilson"]
 
@@ -24,9 +24,9 @@ __all__ = ["LearnedGait", "compare_falls", "load_gait", "wilson"]
 class LearnedGait:
     """Everything needed to replay a faithful run's learned controller."""
 
-    def __init__(self, ref: Reference, config: LearnConfig, data: list, metrics: dict):
+    def __init__(self, ref: Reference, config: LearnConfig, data: list, metrics: LearnSummary):
         self.ref, self.config, self.metrics = ref, config, metrics
-        self.scale = float(metrics["scale_reached"]) or config.schedule.start
+        self.scale = float(metrics.scale_reached) or config.schedule.start
         self.gait = GaitModel(ref, config.schedule.scales(), config.gait)
         self.model = fit_model(data, config)
 
@@ -41,7 +41,7 @@ def load_gait(run_dir) -> LearnedGait:
     from imitwalk.config import from_dict
 
     rd = RunDir(run_dir)
-    metrics = rd.read_json("metrics.json")
+    metrics = rd.read_summary()
     cfg = from_dict(LearnConfig, rd.read_json("config.json")["learn"])
     data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
     return LearnedGait(Reference.load(rd.file("reference.npz")), cfg, data, metrics)
