@@ -94,3 +94,15 @@ def test_the_breakdown_counts_each_perturbed_robots_fall_once():
     perturbed = sum(r.metrics.fell for r in runs if r.furthest is not None)
     assert sum(side.falls_by_furthest_factor.values()) == perturbed
     assert side.abs_yaw_deg == 2.0 and side.progress_ratio_min == 0.9
+
+
+def test_a_verdict_file_of_another_layout_is_a_one_line_error():
+    from imitwalk.errors import RunError
+    from imitwalk.judge.records import PushVerdict
+
+    old = {"settings": {"seeds": 40, "seconds": 30.0, "engine": "mujoco", "scale": 1.0,
+                        "channel_gain": 0.5}, "controllers": {}}  # fmt: skip
+    with pytest.raises(RunError, match=r"^old\.json: not a protocol verdict of this imitwalk"):
+        ProtocolVerdict.from_dict(old, "old.json")
+    with pytest.raises(RunError, match=r"^p\.json: not a push-recovery table"):
+        PushVerdict.from_dict({"controllers": {}}, "p.json")

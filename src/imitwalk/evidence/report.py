@@ -182,7 +182,8 @@ def _evaluations(rd: RunDir) -> str:
             "<code>imitwalk evaluate RUN --protocol eval</code> (or hard, bullet).</p>"
         )
     return "".join(
-        tables.protocol_table(ProtocolVerdict.from_dict(rd.read_json(name))) for name in found
+        tables.protocol_table(ProtocolVerdict.from_dict(rd.read_json(name), str(rd.file(name))))
+        for name in found
     )
 
 
@@ -194,7 +195,8 @@ def _robustness(rd: RunDir, kick: tuple) -> str:
             '<p class="missing">No <code>push_recovery.json</code>: run '
             "<code>imitwalk evaluate RUN --push-recovery</code>.</p>"
         )
-    res = PushVerdict.from_dict(rd.read_json("push_recovery.json"))
+    name = "push_recovery.json"
+    res = PushVerdict.from_dict(rd.read_json(name), str(rd.file(name)))
     return _img(curves.push_polar(res), "push recovery") + tables.push_table(res) + body
 
 

@@ -9,7 +9,11 @@ as ``protocol_NAME.json``, and :meth:`~ProtocolVerdict.from_dict` reads such a f
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
+from typing import TypeVar
+
+from imitwalk.errors import RunError
 
 __all__ = [
     "ControllerVerdict",
@@ -21,6 +25,19 @@ __all__ = [
     "PushVerdict",
     "SeedRow",
 ]
+
+
+T = TypeVar("T")
+
+
+def _read(build: Callable[[], T], where: str, what: str) -> T:
+    """``build()``, with a file of another layout (an older release's) as one line."""
+    try:
+        return build()
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise RunError(
+            f"{where}: not {what} of this imitwalk ({type(exc).__name__}: {exc})"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -131,15 +148,22 @@ class ProtocolVerdict:
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> ProtocolVerdict:
-        """The record :meth:`to_dict` wrote."""
-        st = d["settings"]
-        return cls(
-            protocol=ProtocolId(**d["protocol"]),
-            settings=JudgeSettings(**{**st, "controllers": tuple(st["controllers"])}),
-            controllers={c: ControllerVerdict.from_dict(v) for c, v in d["controllers"].items()},
-            comparison=dict(d.get("comparison", {})),
-        )
+    def from_dict(cls, d: dict, where: str = "the verdict") -> ProtocolVerdict:
+        """The record :meth:`to_dict` wrote (read from ``where``; a one-line
+        :class:`~imitwalk.errors.RunError` for another layout)."""
+
+        def build() -> ProtocolVerdict:
+            st = d["settings"]
+            return cls(
+                protocol=ProtocolId(**d["protocol"]),
+                settings=JudgeSettings(**{**st, "controllers": tuple(st["controllers"])}),
+                controllers={
+                    c: ControllerVerdict.from_dict(v) for c, v in d["controllers"].items()
+                },
+                comparison=dict(d.get("comparison", {})),
+            )
+
+        return _read(build, where, "a protocol verdict")
 
 
 @dataclass(frozen=True)
@@ -182,9 +206,14 @@ class PushVerdict:
         return {"settings": st, "controllers": {c: asdict(v) for c, v in self.controllers.items()}}
 
     @classmethod
-    def from_dict(cls, d: dict) -> PushVerdict:
-        """The record :meth:`to_dict` wrote."""
-        st = d["settings"]
-        tuples = {k: tuple(st[k]) for k in ("directions", "kick_times_s")}
-        settings = PushSettings(**{**st, **tuples})
-        return cls(settings, {c: PushSide(**v) for c, v in d["controllers"].items()})
+    def from_dict(cls, d: dict, where: str = "the push recovery") -> PushVerdict:
+        """The record :meth:`to_dict` wrote (read from ``where``; a one-line
+        :class:`~imitwalk.errors.RunError` for another layout)."""
+
+        def build() -> PushVerdict:
+            st = d["settings"]
+            tuples = {k: tuple(st[k]) for k in ("directions", "kick_times_s")}
+            settings = PushSettings(**{**st, **tuples})
+            return cls(settings, {c: PushSide(**v) for c, v in d["controllers"].items()})
+
+        return _read(build, where, "a push-recovery table")
