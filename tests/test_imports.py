@@ -68,3 +68,16 @@ def test_the_retarget_package_names_every_lazy_name_once():
     for name in pkg.__all__:
         assert getattr(pkg, name) is not None
     assert not hasattr(pkg, "no_such_name")  # an AttributeError, as for any module
+
+
+def test_no_module_imports_itself_through_others():
+    """No import cycle between imitwalk's modules, function-level imports included."""
+    import grimp
+
+    graph = grimp.build_graph("imitwalk")
+    cycles = []
+    for module in sorted(graph.modules):
+        for imported in graph.find_modules_directly_imported_by(module):
+            if graph.chain_exists(importer=imported, imported=module):
+                cycles.append((module, imported))
+    assert cycles == []

@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Final, Required, TypedDict
 
 from imitwalk.errors import RobotError, unknown_name
+from imitwalk.robots.rolenames import LEG_ROLES, ROLES
 
 __all__ = ["MAP_KEYS", "SERVO_GROUPS", "JointMap", "SoleSpec", "load_joint_map", "parse_joint_map"]
 
@@ -230,8 +231,6 @@ def parse_joint_map(data: dict, source: str = "") -> JointMap:
     Raises:
         RobotError: a field of the wrong type, a non-finite number, an unknown role.
     """
-    from imitwalk.robots.spec import LEG_ROLES, ROLES
-
     src = source or "(in memory)"
     data = _object(data, src, "(top level)", "fields")
     for key in data:

@@ -21,21 +21,10 @@ from imitwalk.errors import RobotError, unknown_name
 from imitwalk.robots.assemble import plan_additions
 from imitwalk.robots.build import Additions, compile_model
 from imitwalk.robots.jointmap import JointMap, load_joint_map, parse_joint_map
+from imitwalk.robots.rolenames import ARM_ROLES, LEG_ROLES, ROLES, SIDES, TRUNK_ROLES
 from imitwalk.robots.servos import actuator_kind, torque_limit
 
 __all__ = ["ARM_ROLES", "LEG_ROLES", "ROLES", "TRUNK_ROLES", "Robot", "load_joint_map"]
-
-_SIDES = ("l", "r")
-_LEG = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
-_ARM = ("shoulder_pitch", "shoulder_roll", "arm_yaw", "elbow", "hand")
-#: Leg roles, per side: yaw about +z, roll about +x, pitch about +y (right-hand rule,
-#: x forward, y left, z up); knee flexion positive.
-LEG_ROLES: tuple[str, ...] = tuple(f"{s}_{j}" for s in _SIDES for j in _LEG)
-#: Arm roles, per side; zero hangs the arm straight down.
-ARM_ROLES: tuple[str, ...] = tuple(f"{s}_{j}" for s in _SIDES for j in _ARM)
-TRUNK_ROLES: tuple[str, ...] = ("waist_yaw", "neck_yaw", "neck_pitch")
-#: Every canonical role, in the order trajectories use.
-ROLES: tuple[str, ...] = LEG_ROLES + ARM_ROLES + TRUNK_ROLES
 
 #: A standing posture that is not the file's own keyframe is lowered onto the floor: its
 #: lowest sole this far above it [m] (as :meth:`imitwalk.sim.mujoco.MujocoPlant.reset` does).
@@ -154,7 +143,7 @@ def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Addit
         data.qpos[adr[roles.index(role)]] = val * signs[roles.index(role)]
     mujoco.mj_kinematics(model, data)
     if key is None or jm.stand:  # not the file's own posture: put it on the floor
-        low = min(_frame_pos(model, data, res.soles[s])[2] for s in _SIDES)
+        low = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
         data.qpos[2] -= low - SOLE_CLEARANCE
     mujoco.mj_forward(model, data)
     if not np.isfinite(data.qpos).all() or not np.isfinite(data.xpos).all():
@@ -186,7 +175,7 @@ def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Addit
             )
             ctrl[a] = np.clip(data.qpos[model.jnt_qposadr[j]], lo, hi)
     root = int(model.body_rootid[model.body(res.torso).id])
-    sole_z = min(_frame_pos(model, data, res.soles[s])[2] for s in _SIDES)
+    sole_z = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
     return cls(
         name=jm.name or mjcf.stem,
         mjcf=mjcf,
