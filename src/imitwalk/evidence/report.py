@@ -18,6 +18,7 @@ import json
 import time
 from pathlib import Path
 
+from imitwalk.config import schedule_scales
 from imitwalk.evidence import curves, media, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.judge import tables
@@ -169,8 +170,7 @@ def _display_gait(lg: LoadedRun) -> GaitModel:
         return lg.gait.gait
     cfg = lg.metrics.config
     start, step = float(cfg.get("start", 0.3)), float(cfg.get("step", 0.1))
-    n = int(round((lg.scale - start) / step)) + 1 if lg.scale >= start else 1
-    scales = sorted({round(start + i * step, 6) for i in range(max(n, 1))} | {lg.scale})
+    scales = sorted({*schedule_scales(start, step, max(lg.scale, start)), lg.scale})
     return GaitModel(lg.ref, scales, GaitConfig())
 
 

@@ -78,10 +78,8 @@ _CACHE: dict[tuple[str, int], LoadedRun] = {}
 
 
 def _loaded(run_dir: str) -> LoadedRun:
-    rd = RunDir(run_dir)
-    if not rd.exists("metrics.json"):
-        rd.read_summary()  # the one-line RunError of a folder that is not a finished run
-    key = (run_dir, rd.file("metrics.json").stat().st_mtime_ns)
+    metrics = RunDir(run_dir).file("metrics.json")  # load_run refuses a folder without one
+    key = (run_dir, metrics.stat().st_mtime_ns if metrics.is_file() else -1)
     if key not in _CACHE:
         _CACHE.clear()
         _CACHE[key] = load_run(run_dir)
