@@ -20,7 +20,7 @@ to a moving *walking frame* (see :mod:`imitwalk.retarget.command`).
 Timing: the human cycle time; ``ds`` double support per transition; ψ = 0 is the left
 heel strike, the right foot swings in ψ ∈ [ds, ½), the left in [½ + ds, 1). An
 amplitude envelope ``e(t)`` ∈ [0, 1] scales stride, sway, lift and arm swing, so one
-code path gives both the start-up from standing (``e`` rising over its cycles)
+code path gives both the start-up from standing (``e`` rising over the first cycle)
 and the steady loop (``e ≡ 1``), which is closed by construction.
 """
 
@@ -39,7 +39,6 @@ __all__ = [
     "FOOT_GAP",
     "KNEE_MIN_DEG",
     "START_CYCLES",
-    "SWAY_CYCLES",
     "GaitCommand",
     "GaitParams",
     "LegGeometry",
@@ -54,13 +53,6 @@ FOOT_GAP = 0.01
 
 #: Start-up cycles: one of sway with both feet down, then two of growing stride.
 START_CYCLES = 3
-
-#: Start-up cycles over which the sway grows to its full size: the feet-down cycle and the
-#: first stepping one. Grown within the feet-down cycle alone, the sway rocked the robot
-#: onto one sole's edge before any foot lifted (at the default clip's searched sway, hoap2
-#: lifted a foot 14 mm at friction 1.0 and fell at 1.6 s at 1.5, where a sole cannot slide
-#: out of the rock): docs/RESULTS.md, "The start-up".
-SWAY_CYCLES = 2
 
 #: The knee keeps at least this flexion at the longest stride [deg] (a straight knee at
 #: full stride was why a prototype's full-scale gait failed).
@@ -125,9 +117,8 @@ def plan_walk(
     """Lay out ``cycles`` steady cycles, after :data:`START_CYCLES` start-up cycles if ``start``.
 
     The start-up begins standing with both feet side by side: in its first cycle the
-    sway starts to build up while both feet stay down; then the feet step, with the
-    stride growing smoothly from zero and the sway reaching its full size over
-    :data:`SWAY_CYCLES` cycles; then the steady cycles follow.
+    sway builds up while both feet stay down; then the feet step, with the stride
+    growing smoothly from zero; then the steady cycles follow.
 
     Args:
         template: the human gait; geom: the robot's legs; params: reference parameters.
@@ -163,12 +154,11 @@ def plan_walk(
     n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
     k = np.arange(n)
     psi = (k % n_cyc) / n_cyc
-    # the sway starts in the first start-up cycle (feet down), so the lateral rocking is
-    # under way before a foot leaves the floor, and grows with the first steps; the stride
-    # grows over the other start-up cycles, slowly enough that no step is longer than a
-    # steady one
+    # the sway builds up over the first start-up cycle (feet down), so the lateral rocking
+    # is in full swing before a foot leaves the floor; then the stride grows over the
+    # other start-up cycles, slowly enough that no step is longer than a steady one
     e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
-    e_sway = np.ones(n) if not start else _smoothstep(k / (min(SWAY_CYCLES, ramp) * n_cyc))
+    e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
     stepping = k >= (n_cyc if start else 0)
     path = walking_frame(e, stride / period, cmd, scale, period, dt)  # (N, 5)
     if not start:  # steady: CoM midway between the feet at mid double support
