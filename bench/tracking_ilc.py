@@ -28,6 +28,11 @@ from imitwalk.robots import load_robot
 from imitwalk.sim.mujoco import MujocoPlant, run
 
 
+def fall_s(r) -> float | None:
+    """A rollout's fall time [s], ``None`` if it stayed up."""
+    return float(r.fall_time) if r.fell and r.fall_time is not None else None
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("reference")
@@ -45,8 +50,7 @@ def main() -> None:
     for it in range(args.iters):
         r = run(MujocoPlant(robot, opt), lambda k, _o, q=q_cmd: q[k], len(q_ref), q0=q_ref[0])
         err = q_ref[: len(r.q)] - r.q  # (T', n) encoders only
-        fall = float(r.fall_time) if r.fell and r.fall_time is not None else None
-        print(json.dumps({"iter": it, "fall_s": fall,
+        print(json.dumps({"iter": it, "fall_s": fall_s(r),
                           "rms_err_deg": round(float(np.degrees(np.sqrt(np.mean(err**2)))), 2),
                           "max_err_deg": round(float(np.degrees(np.abs(err).max())), 1)}),
               flush=True)  # fmt: skip
@@ -61,7 +65,7 @@ def main() -> None:
         times = {}
         for name, q in (("reference", q_ref), ("learned commands", q_cmd)):
             r = run(MujocoPlant(robot, d.options), lambda k, _o, q=q: q[k], len(q), q0=q_ref[0])
-            times[name] = float(r.fall_time) if r.fell and r.fall_time is not None else None
+            times[name] = fall_s(r)
         print(json.dumps({"robot": d.seed, "fall_s": times}), flush=True)
 
 
