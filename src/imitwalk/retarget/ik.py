@@ -43,7 +43,7 @@ def _mat(model, data, name: str) -> np.ndarray:
 
 def leg_geometry(robot: Robot) -> LegGeometry:
     """Measure the left leg of ``robot`` at zero joint angles (pelvis frame), and how far
-    the hips stand ahead of and below the centre of mass in the standing posture.
+    the hips stand ahead of the centre of mass in the standing posture.
 
     The hip point is the hip-pitch axis's anchor moved sideways over the ankle (on a
     robot whose hip axes do not meet above the leg, e.g. G1, the pitch hinge sits inside
@@ -56,7 +56,6 @@ def leg_geometry(robot: Robot) -> LegGeometry:
     root0 = int(m.body_rootid[m.body(robot.torso).id])
     hips = [d.xanchor[m.joint(robot.mj_joints[robot.index(f"{s}_hip_pitch")]).id] for s in "lr"]
     hip_ahead = float(np.mean(hips, axis=0)[0] - d.subtree_com[root0][0])
-    com_above_hip = float(d.subtree_com[root0][2] - np.mean(hips, axis=0)[2])
     d.qpos[:] = m.qpos0
     mujoco.mj_kinematics(m, d)
     root = int(m.body_rootid[m.body(robot.torso).id])
@@ -75,7 +74,6 @@ def leg_geometry(robot: Robot) -> LegGeometry:
         foot_length=float(2 * foot.half[0]),
         hip_ahead=hip_ahead,
         foot_width=float(2 * foot.half[1]),
-        com_above_hip=com_above_hip,
     )
 
 

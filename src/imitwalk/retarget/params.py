@@ -74,8 +74,6 @@ class LegGeometry:
         foot_length: sole length [m].
         hip_ahead: hips ahead of the centre of mass when standing [m].
         foot_width: sole width [m] (a sidestep widens the stance to keep the feet apart).
-        com_above_hip: the centre of mass above the hip centres when standing [m] (the
-            start-up's pendulum height is the hip height plus this).
     """
 
     hip_y: float
@@ -86,7 +84,6 @@ class LegGeometry:
     foot_length: float
     hip_ahead: float = 0.0
     foot_width: float = 0.0
-    com_above_hip: float = 0.0
 
     @property
     def hip_height(self) -> float:

@@ -9,9 +9,7 @@ control tick:
 * the **swing foot** along the human foot path (its forward progress and lift profile,
   scaled to the robot), flat, with clearance;
 * the **centre of mass** moving forward steadily with a smooth **sinusoidal** lateral
-  sway over the stance foot (a square-wave sway builds up a growing roll); in the
-  start-up from standing, it first shifts onto the first stance foot as a linear inverted
-  pendulum would (:func:`_start_sway`), then joins the sinusoid;
+  sway over the stance foot (a square-wave sway builds up a growing roll);
 * the **pelvis** level, at a fixed height chosen to keep the knee bent;
 * the **arms and waist** swinging as the human's do (scaled with the stride).
 
@@ -22,7 +20,7 @@ to a moving *walking frame* (see :mod:`imitwalk.retarget.command`).
 Timing: the human cycle time; ``ds`` double support per transition; ψ = 0 is the left
 heel strike, the right foot swings in ψ ∈ [ds, ½), the left in [½ + ds, 1). An
 amplitude envelope ``e(t)`` ∈ [0, 1] scales stride, sway, lift and arm swing, so one
-code path gives both the start-up from standing (``e`` rising over its cycles)
+code path gives both the start-up from standing (``e`` rising over the first cycle)
 and the steady loop (``e ≡ 1``), which is closed by construction.
 """
 
@@ -34,7 +32,6 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.command import GaitCommand, check_side, cycle_motion, place, walking_frame
-from imitwalk.retarget.lipm import lipm_com
 from imitwalk.retarget.params import GaitParams, LegGeometry, leg_scaled
 from imitwalk.retarget.template import GaitTemplate
 
@@ -54,12 +51,8 @@ __all__ = [
 #: :data:`~imitwalk.retarget.params.REFERENCE_LEG` (scaled with the robot's leg).
 FOOT_GAP = 0.01
 
-#: Start-up cycles: one of weight shift with both feet down, then two of growing stride.
+#: Start-up cycles: one of sway with both feet down, then two of growing stride.
 START_CYCLES = 3
-
-#: Start-up cycles over which the weight shift hands over to the steady sinusoidal sway,
-#: from the first lift-off on.
-SWAY_HANDOVER = 1.0
 
 #: The knee keeps at least this flexion at the longest stride [deg] (a straight knee at
 #: full stride was why a prototype's full-scale gait failed).
@@ -108,42 +101,6 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
 def _profile(p: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Evaluate a ``(PHASES,)`` profile sampled on [0, 1] at ``s``."""
     return np.interp(s, np.linspace(0.0, 1.0, len(p)), p)
-
-
-def _support(psi: np.ndarray, ds: float) -> np.ndarray:
-    """``(N,)`` which sole carries the weight in a steady walk: +1 the left, −1 the right,
-    moving across over each double support (the left heel strikes at ψ = 0)."""
-    w = np.where(psi < 0.5, 1.0, -1.0)
-    if ds > 0:
-        w = np.where(psi < ds, -1.0 + 2.0 * _smoothstep(psi / ds), w)
-        w = np.where((psi >= 0.5) & (psi < 0.5 + ds), 1.0 - 2.0 * _smoothstep((psi - 0.5) / ds), w)
-    return w
-
-
-def _start_sway(
-    sine: np.ndarray, psi: np.ndarray, ds: float, n_cyc: int, reach: float, dt: float, height: float
-) -> np.ndarray:
-    """``(N,)`` the lateral centre of mass [m] of a plan that starts from standing.
-
-    The ZMP stays between the feet for half the first cycle, then moves over to the left
-    sole (``reach`` [m] to the side), which carries the first step (the right foot lifts at
-    ψ = ds of the second cycle), and from there alternates as in :func:`_support`; the
-    centre of mass is its linear inverted pendulum (:func:`~imitwalk.retarget.lipm.lipm_com`,
-    ``height`` [m] above the soles). From the first lift-off it hands over to the steady
-    sinusoid ``sine`` over :data:`SWAY_HANDOVER` cycles. A sinusoid grown from zero within
-    the feet-down cycle swung the weight out over the right sole before the left took it,
-    with the ZMP within a centimetre of the sole's outer edge, and hoap2 rocked onto that
-    edge: 12° of roll on the nominal floor, and a fall at 1.6 s on floors of friction
-    1.2 and up (docs/RESULTS.md, "The start-up").
-    """
-    k = np.arange(len(psi))
-    w = _support(psi, ds)
-    first = k < n_cyc
-    w[first] = _smoothstep((k[first] - 0.5 * n_cyc) / (0.5 * n_cyc))
-    w[(k >= n_cyc) & (k < 2 * n_cyc) & (psi < ds)] = 1.0  # already on the left sole
-    shift = lipm_com(reach * w, dt, height)
-    beta = 1.0 - _smoothstep((k - (1.0 + ds) * n_cyc) / (SWAY_HANDOVER * n_cyc))
-    return beta * shift + (1.0 - beta) * sine
 
 
 def plan_walk(
@@ -197,14 +154,16 @@ def plan_walk(
     n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
     k = np.arange(n)
     psi = (k % n_cyc) / n_cyc
-    # the stride grows over the start-up cycles after the first (feet down), slowly
-    # enough that no step is longer than a steady one
+    # the sway builds up over the first start-up cycle (feet down), so the lateral rocking
+    # is in full swing before a foot leaves the floor; then the stride grows over the
+    # other start-up cycles, slowly enough that no step is longer than a steady one
     e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
+    e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
     stepping = k >= (n_cyc if start else 0)
     path = walking_frame(e, stride / period, cmd, scale, period, dt)  # (N, 5)
     if not start:  # steady: CoM midway between the feet at mid double support
         path[:, 0] -= stride / 4 + stride * ds / 2
-    com_y = params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
+    com_y = e_sway * params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
     soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
     yaw = np.zeros((n, 2))
     stance = np.zeros((n, 2), dtype=bool)
@@ -245,9 +204,6 @@ def plan_walk(
     if cap_scale is not None:
         hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start, cmd))
     pelvis_z = np.full(n, hip + geom.hip_z)
-    if start:
-        reach = params.sway * y_foot
-        com_y = _start_sway(com_y, psi, ds, n_cyc, reach, dt, hip + geom.com_above_hip)
     pitch = float(np.radians(cmd.slope_deg))
     # on a slope the CoM sits over the feet along gravity: its height × tan(slope) uphill
     lean = params.lean + (hip + geom.hip_z) * np.tan(pitch)
