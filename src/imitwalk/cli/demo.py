@@ -10,6 +10,7 @@ evaluate`` with their defaults are the full-budget versions.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from imitwalk.cli.progress import progress
@@ -58,9 +59,9 @@ def run_demo(out: Path) -> dict:
         else:
             motion = load_motion(default_clip())
             progress(f"[1/4] retarget {Path(motion.source).name}: IK on the robot + search")
+            cfg = apply_overrides(RetargetConfig(), DEMO_RETARGET)
             # IK only at the scales the demo's schedule walks (not the full 0.1 … 1.0 grid)
-            scales = "scales=" + ",".join(f"{x:g}" for x in lcfg.scales())
-            cfg = apply_overrides(RetargetConfig(), [*DEMO_RETARGET, scales])
+            cfg = replace(cfg, scales=lcfg.scales())
             ref = do_retarget(
                 motion,
                 robot,
