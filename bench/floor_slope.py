@@ -55,9 +55,7 @@ class Kinematics:
         self.d.qpos[self.qadr] = q * self.sign
         mujoco.mj_kinematics(self.m, self.d)
         imu = self.d.site_xmat[self.imu].reshape(3, 3)
-        return np.array(
-            [_pitch(self.d.site_xmat[s].reshape(3, 3).T @ imu) for s in self.soles]
-        )
+        return np.array([_pitch(self.d.site_xmat[s].reshape(3, 3).T @ imu) for s in self.soles])
 
 
 class SlopePolicy(TickPolicy):
