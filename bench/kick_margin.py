@@ -73,19 +73,15 @@ def main() -> None:
     lo, hi = dict.fromkeys(keys, 0.0), dict.fromkeys(keys, top)
     for _ in range(args.steps):
         mids = {k: (lo[k] + hi[k]) / 2 for k in keys}
-        res = run_parallel(
-            run_tick_episode,
-            [
-                job(laws[i], draws[j], (t, a, mids[(i, j, t, a)])) for i, j, t, a in keys
-            ],  # fmt: skip
-        )
+        jobs = [job(laws[i], draws[j], (t, a, mids[(i, j, t, a)])) for i, j, t, a in keys]
+        res = run_parallel(run_tick_episode, jobs)
         for k, r in zip(keys, res, strict=True):
             (hi if r.fell else lo)[k] = mids[k]
     for i, law in enumerate(LAWS):
         per_dir = {}
         for a, name in zip(DIRECTIONS, ("forward", "left", "back", "right"), strict=True):
-            per_dir[name] = round(float(np.mean([
-                lo.get((i, j, t, a), 0.0) for j in range(len(draws)) for t in times])), 3)  # fmt: skip
+            got = [lo.get((i, j, t, a), 0.0) for j in range(len(draws)) for t in times]
+            per_dir[name] = round(float(np.mean(got)), 3)
         print(json.dumps({
             "pitch_roll_heading": list(law),
             "unkicked_falls": int((~up[i]).sum()),
