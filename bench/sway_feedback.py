@@ -1,4 +1,4 @@
-"""A lead, not a product option: the sideways centre of mass closed every tick, with a run's laws.
+"""A lead, not a product option: the sideways sway closed on what the robot measures.
 
 On G1 this law made the body follow its first weight shift (docs/RESULTS.md, "Other
 robots"). hoap2's grippy-floor start-up falls look alike: the start-up rocks the robot onto
@@ -15,10 +15,23 @@ variants (seeds from ``--first``; neither training nor evaluation robots):
   over the soles on both hip and ankle rolls (torso and soles keep their tilt; a Jacobian
   solved once on the first posture). With ``--double-only`` it acts only while the plan
   has both feet down, with ``--startup-only`` only in the reference's start-up.
+- **Clock:** with ``K`` > 0 the reference's clock is coupled to the body's measured
+  sideways oscillation (eq. 9's phase advance driven by the sensors, as Morimoto et al.,
+  ICRA 2006, couple a sinusoidal pattern to the measured centre of pressure). The phases
+  are φ = atan2(−ẏ/ω, y) of the measured and the planned sideways centre of mass (ω the
+  gait's angular frequency), and the clock runs at ``1 + (K/ω)·sin(φ_meas − φ_plan)``
+  (never backwards): it waits for a body that lags and hurries after one that leads.
+
+A law is ``kp,kd,K``. With a reference (``.npz``) instead of a run, the reference is
+walked open loop at ``--scale`` on training robots (variant ``train``). Prints one JSON
+line per (variant, law): falls, their times, the mean distance [m] (ground truth, for the
+figure only) and the least reference time reached [s]; then a summary.
 
 Usage: ``python bench/sway_feedback.py RUN [--controller learned] [--robots 40]
-[--first 300000] [--seconds 30] [--variants friction,nokicks,eval] [--laws '0,0;-1,-0.1']
-[--double-only] [--startup-only]``; prints one JSON line per (variant, law), then a summary.
+[--first 300000] [--seconds 30] [--variants friction,nokicks,hard,eval]
+[--laws '0,0,0;-1,-0.1,0;0,0,2'] [--double-only] [--startup-only]``, or ``python
+bench/sway_feedback.py REF.npz --robot g1.json --scale 0.3 --robots 4 --seconds 10
+--variants train --clip 0.04 --laws ...``.
 """
 
 from __future__ import annotations
@@ -36,6 +49,7 @@ from imitwalk.judge.replay import OPEN_LOOP, load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget import Reference
 from imitwalk.robots import load_robot
+from imitwalk.sim.perturb import perturbed, train_seeds
 
 ROLLS = ("l_hip_roll", "r_hip_roll", "l_ankle_roll", "r_ankle_roll")
 
@@ -99,69 +113,91 @@ def _rot(roll: float, pitch: float) -> np.ndarray:
 
 
 class SwayPolicy:
-    """A run's :class:`TickPolicy` plus the sideways centre-of-mass law."""
+    """A run's :class:`TickPolicy` plus the sideways law and the coupled clock."""
 
-    def __init__(self, ref, scale, laws, robot, seconds, kp, kd, clip, double_only, startup_only):
-        self.inner = TickPolicy(ref, scale, laws, robot.joint_names, seconds)
-        self.kin, self.kp, self.kd, self.clip = Kinematics(robot), kp, kd, clip
+    def __init__(self, ref, scale, laws, robot, seconds, law, clip, double_only, startup_only):
+        self.inner = TickPolicy(ref, scale, laws, robot.joint_names, 2 * seconds)
+        self.kin, (self.kp, self.kd, self.K), self.clip = Kinematics(robot), law, clip
         self.u = self.kin.shift_direction(self.inner.q0)
         self.est = StateEstimator(ref.dt, tau=2.0)
         self.a, self.dt = ref.dt / (ref.dt + 0.03), ref.dt
+        self.w = 2 * np.pi / (ref.loops.shape[1] * ref.dt)  # gait frequency [rad/s]
+        y = []
+        for q in self.inner.q_ref:
+            com, _, left = self.kin.pose(q)
+            y.append((left.T @ com)[1])
+        self.y_plan = np.array(y)  # (T,) planned sideways centre of mass [m]
+        self.z_plan = np.stack([self.y_plan, -np.gradient(self.y_plan, ref.dt) / self.w], 1)
         plan = ref.plan_at(scale)
         self.lifted = (np.stack([plan["l_sole"][:, 2], plan["r_sole"][:, 2]], 1) > 1e-4).any(1)
         self.double_only, self.startup_only = double_only, startup_only
-        self.e_prev = self.rate = 0.0
+        self.y_prev: float | None = None
+        self.e_prev = self.rate = self.e_rate = self.clock = 0.0
 
     @property
     def q0(self) -> np.ndarray:
         return self.inner.q0
 
     def __call__(self, k: int, obs) -> np.ndarray:
-        q = self.inner(k, obs)
         s = self.est.update(obs.gyro, obs.accel, obs.foot_force)
-        plan_q = self.inner.q_ref[min(k, len(self.inner.q_ref) - 1)]
         com, tor, _ = self.kin.pose(obs.joints)
-        meas = (_rot(s.roll, s.pitch) @ tor.T @ com)[1]
-        com, _, left = self.kin.pose(plan_q)
-        e = float(meas - (left.T @ com)[1])
-        self.rate = (1 - self.a) * self.rate + self.a * (e - self.e_prev) / self.dt
+        y = float((_rot(s.roll, s.pitch) @ tor.T @ com)[1])
+        self.y_prev = y if self.y_prev is None else self.y_prev
+        self.rate = (1 - self.a) * self.rate + self.a * (y - self.y_prev) / self.dt
+        self.y_prev = y
+        i = min(int(self.clock + 1e-9), len(self.y_plan) - 1)  # the reference's tick
+        zr, zc = np.array([y, -self.rate / self.w]), self.z_plan[i]
+        sin = (zc[0] * zr[1] - zc[1] * zr[0]) / (np.linalg.norm(zc) * np.linalg.norm(zr) + 1e-4)
+        self.clock += max(0.0, 1.0 + self.K / self.w * sin)
+        q = self.inner(i, obs)
+        e = y - float(self.y_plan[i])
+        self.e_rate = (1 - self.a) * self.e_rate + self.a * (e - self.e_prev) / self.dt
         self.e_prev = e
         n0, nl = self.inner.start, self.inner.n_loop
-        if self.startup_only and k >= n0:
+        if self.startup_only and i >= n0:
             return q
         if self.double_only:
-            i = k if k < n0 else n0 + (k - n0) % nl
-            if self.lifted[min(i, len(self.lifted) - 1)]:
+            j = i if i < n0 else n0 + (i - n0) % nl
+            if self.lifted[min(j, len(self.lifted) - 1)]:
                 return q
-        return q + float(np.clip(self.kp * e + self.kd * self.rate, -self.clip, self.clip)) * self.u
+        return (
+            q + float(np.clip(self.kp * e + self.kd * self.e_rate, -self.clip, self.clip)) * self.u
+        )
 
 
-def _walk(job) -> tuple[bool, float | None]:
-    path, robot_name, scale, laws, options, seconds, kp, kd, clip, double_only, startup_only = job
+def _walk(job) -> tuple[bool, float | None, float, float]:
+    path, robot_name, scale, laws, options, seconds, law, clip, double_only, startup_only = job
     from imitwalk.sim.mujoco import make_plant, run
 
     ref, robot = Reference.load(path), load_robot(robot_name)
-    policy = SwayPolicy(ref, scale, laws, robot, seconds, kp, kd, clip, double_only, startup_only)
-    ro = run(make_plant(robot, ref.sim_options(options)), policy, len(policy.inner.q_ref))
-    return bool(ro.fell), ro.fall_time
+    policy = SwayPolicy(ref, scale, laws, robot, seconds, law, clip, double_only, startup_only)
+    ro = run(make_plant(robot, ref.sim_options(options)), policy, round(seconds / ref.dt))
+    distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
+    return bool(ro.fell), ro.fall_time, distance, policy.clock * ref.dt
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("run_dir")
+    ap.add_argument("source", help="a per-tick run folder, or a reference (.npz)")
     ap.add_argument("--robot", default="hoap2")
     ap.add_argument("--controller", default="learned")
+    ap.add_argument("--scale", type=float, default=0.3, help="with a reference")
     ap.add_argument("--robots", type=int, default=40)
     ap.add_argument("--first", type=int, default=300_000)
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--variants", default="friction,nokicks,eval")
-    ap.add_argument("--laws", default="0,0;-1,-0.1", help="kp,kd pairs, ';'-separated")
+    ap.add_argument("--laws", default="0,0,0;-1,-0.1,0", help="kp,kd,K triples, ';'-separated")
     ap.add_argument("--clip", type=float, default=0.02, help="largest shift [m]")
     ap.add_argument("--double-only", action="store_true")
     ap.add_argument("--startup-only", action="store_true", help="act in the start-up alone")
     args = ap.parse_args()
-    run, robot = load_run(args.run_dir), load_robot(args.robot)
-    laws = () if args.controller == OPEN_LOOP else tuple(run.laws[args.controller])
+    robot = load_robot(args.robot)
+    if args.source.endswith(".npz"):
+        path, ref, scale, laws = args.source, Reference.load(args.source), args.scale, ()
+    else:
+        run = load_run(args.source)
+        path, ref, scale = run.path + "/reference.npz", run.ref, run.scale
+        laws = () if args.controller == OPEN_LOOP else tuple(run.laws[args.controller])
     hard = load_protocol("hard")
     protos = {
         "friction": hard.only(("friction",)),
@@ -171,20 +207,29 @@ def main() -> None:
     }
     summary = {}
     for name in args.variants.split(","):
-        p = protos[name]
-        draws = [p.draw(args.first + s, robot, run.ref.sim_options(), args.seconds)
-                 for s in range(args.robots)]  # fmt: skip
-        for law in args.laws.split(";"):
-            kp, kd = (float(x) for x in law.split(","))
-            jobs = [(run.path + "/reference.npz", args.robot, run.scale, laws, d.options,
-                     args.seconds, kp, kd, args.clip, args.double_only, args.startup_only)
-                    for d in draws]  # fmt: skip
+        if name == "train":
+            options = [perturbed(s, ref.sim_options()) for s in train_seeds(args.robots)]
+        else:
+            p = protos[name]
+            options = [p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
+                       for s in range(args.robots)]  # fmt: skip
+        for text in args.laws.split(";"):
+            law = tuple(float(x) for x in text.split(","))
+            jobs = [(path, args.robot, scale, laws, o, args.seconds, law, args.clip,
+                     args.double_only, args.startup_only) for o in options]  # fmt: skip
             res = run_parallel(_walk, jobs)
-            times = sorted(round(t, 2) for f, t in res if f)
-            row = {"variant": name, "kp": kp, "kd": kd, "falls": len(times), "fall_times_s": times}
-            summary[f"{name} {law}"] = len(times)
+            times = sorted(round(t, 2) for f, t, _, _ in res if f)
+            row = {
+                "variant": name,
+                "law": dict(zip(("kp", "kd", "K"), law, strict=True)),
+                "falls": len(times),
+                "fall_times_s": times,
+                "distance_m": round(float(np.mean([r[2] for r in res])), 2),
+                "least_reference_s": round(min(r[3] for r in res), 2),
+            }
+            summary[f"{name} {text}"] = len(times)
             print(json.dumps(row), flush=True)
-    print(json.dumps({"run": args.run_dir, "clip_m": args.clip, "double_only": args.double_only,
+    print(json.dumps({"source": args.source, "clip_m": args.clip, "double_only": args.double_only,
                       "startup_only": args.startup_only, "falls": summary}))  # fmt: skip
 
 
