@@ -21,6 +21,8 @@ variants (seeds from ``--first``; neither training nor evaluation robots):
   are φ = atan2(−ẏ/ω, y) of the measured and the planned sideways centre of mass (ω the
   gait's angular frequency), and the clock runs at ``1 + (K/ω)·sin(φ_meas − φ_plan)``
   (never backwards): it waits for a body that lags and hurries after one that leads.
+  ``--lag`` [rad] is subtracted from that phase difference (the body's nominal lag; each
+  row prints the mean lag measured in the steady loop).
 
 A law is ``kp,kd,K``. With a reference (``.npz``) instead of a run, the reference is
 walked open loop at ``--scale`` on training robots (variant ``train``). Prints one JSON
@@ -115,7 +117,9 @@ def _rot(roll: float, pitch: float) -> np.ndarray:
 class SwayPolicy:
     """A run's :class:`TickPolicy` plus the sideways law and the coupled clock."""
 
-    def __init__(self, ref, scale, laws, robot, seconds, law, clip, double_only, startup_only):
+    def __init__(
+        self, ref, scale, laws, robot, seconds, law, clip, double_only, startup_only, lag=0.0
+    ):
         self.inner = TickPolicy(ref, scale, laws, robot.joint_names, 2 * seconds)
         self.kin, (self.kp, self.kd, self.K), self.clip = Kinematics(robot), law, clip
         self.u = self.kin.shift_direction(self.inner.q0)
@@ -132,6 +136,7 @@ class SwayPolicy:
         self.lifted = (np.stack([plan["l_sole"][:, 2], plan["r_sole"][:, 2]], 1) > 1e-4).any(1)
         self.double_only, self.startup_only = double_only, startup_only
         self.y_prev: float | None = None
+        self.lag, self.lags = lag, []
         self.e_prev = self.rate = self.e_rate = self.clock = 0.0
 
     @property
@@ -147,7 +152,11 @@ class SwayPolicy:
         self.y_prev = y
         i = min(int(self.clock + 1e-9), len(self.y_plan) - 1)  # the reference's tick
         zr, zc = np.array([y, -self.rate / self.w]), self.z_plan[i]
-        sin = (zc[0] * zr[1] - zc[1] * zr[0]) / (np.linalg.norm(zc) * np.linalg.norm(zr) + 1e-4)
+        cross, dot = zc[0] * zr[1] - zc[1] * zr[0], zc[0] * zr[0] + zc[1] * zr[1]
+        if i >= self.inner.start:  # the steady loop: the body's phase less the plan's
+            self.lags.append(np.arctan2(cross, dot))
+        c, sl = np.cos(self.lag), np.sin(self.lag)  # less the nominal lag
+        sin = (c * cross - sl * dot) / (np.linalg.norm(zc) * np.linalg.norm(zr) + 1e-4)
         self.clock += max(0.0, 1.0 + self.K / self.w * sin)
         q = self.inner(i, obs)
         e = y - float(self.y_plan[i])
@@ -165,15 +174,16 @@ class SwayPolicy:
         )
 
 
-def _walk(job) -> tuple[bool, float | None, float, float]:
-    path, robot_name, scale, laws, options, seconds, law, clip, double_only, startup_only = job
+def _walk(job) -> tuple[bool, float | None, float, float, float]:
+    path, robot_name, scale, laws, options, seconds, law, clip, double_only, startup_only, lag = job
     from imitwalk.sim.mujoco import make_plant, run
 
     ref, robot = Reference.load(path), load_robot(robot_name)
-    policy = SwayPolicy(ref, scale, laws, robot, seconds, law, clip, double_only, startup_only)
+    policy = SwayPolicy(ref, scale, laws, robot, seconds, law, clip, double_only, startup_only, lag)
     ro = run(make_plant(robot, ref.sim_options(options)), policy, round(seconds / ref.dt))
     distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
-    return bool(ro.fell), ro.fall_time, distance, policy.clock * ref.dt
+    lag = float(np.angle(np.mean(np.exp(1j * np.array(policy.lags))))) if policy.lags else 0.0
+    return bool(ro.fell), ro.fall_time, distance, policy.clock * ref.dt, lag
 
 
 def main() -> None:
@@ -190,6 +200,7 @@ def main() -> None:
     ap.add_argument("--clip", type=float, default=0.02, help="largest shift [m]")
     ap.add_argument("--double-only", action="store_true")
     ap.add_argument("--startup-only", action="store_true", help="act in the start-up alone")
+    ap.add_argument("--lag", type=float, default=0.0, help="the body's nominal phase lag [rad]")
     args = ap.parse_args()
     robot = load_robot(args.robot)
     if args.source.endswith(".npz"):
@@ -216,9 +227,9 @@ def main() -> None:
         for text in args.laws.split(";"):
             law = tuple(float(x) for x in text.split(","))
             jobs = [(path, args.robot, scale, laws, o, args.seconds, law, args.clip,
-                     args.double_only, args.startup_only) for o in options]  # fmt: skip
+                     args.double_only, args.startup_only, args.lag) for o in options]  # fmt: skip
             res = run_parallel(_walk, jobs)
-            times = sorted(round(t, 2) for f, t, _, _ in res if f)
+            times = sorted(round(t, 2) for f, t, *_ in res if f)
             row = {
                 "variant": name,
                 "law": dict(zip(("kp", "kd", "K"), law, strict=True)),
@@ -226,6 +237,9 @@ def main() -> None:
                 "fall_times_s": times,
                 "distance_m": round(float(np.mean([r[2] for r in res])), 2),
                 "least_reference_s": round(min(r[3] for r in res), 2),
+                "mean_lag_rad": round(
+                    float(np.angle(np.mean(np.exp(1j * np.array([r[4] for r in res]))))), 3
+                ),
             }
             summary[f"{name} {text}"] = len(times)
             print(json.dumps(row), flush=True)
