@@ -1,0 +1,234 @@
+"""A lead, not a product option: the servos' sag taken out of the reference by inverse dynamics.
+
+A position servo holds its joint only where its torque ``kp·(q_target − q) − kv·q̇`` is
+what the motion needs, so a robot played its reference sags and lags: in single support
+G1's stance hip roll carries about m·g·(half the stance width) ≈ 39 Nm, 4.5° at kp 500.
+This bench adds to every joint target the offset ``(τ + kv·q̇_ref)/kp`` (Craig's
+computed-torque feedforward, through a position servo), where ``τ`` is the joint torque
+the reference needs on the *nominal* model (no sensor, no state of the simulation):
+
+- the floating base is placed every tick so that the planned stance sole stays flat and
+  still (its velocity from the sole's Jacobian, its acceleration by finite differences);
+- ``mj_inverse`` gives the generalised forces of that motion, contacts off;
+- the soles' wrenches are what the base's six rows need (one sole: solved; both:
+  least norm weighted by each sole's share of the plan's load), and ``τ`` the rest.
+
+``--fraction`` scales the offset (0: the reference as it is). The walk is the run's
+controller (or open loop on a reference, with ``--gains`` as in ``bench/step_width.py``),
+on training robots (variant ``train``) or validation robots of hard's variants. Prints
+one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
+truth, for the figure only) and the largest offset [rad].
+
+Usage: ``python bench/feedforward.py REF.npz --robot g1.json --scale 0.3 --robots 4
+--seconds 10 --variants train --fractions 0,0.5,1 [--gains ankle_pitch:gyro_y=0.05]``,
+or ``python bench/feedforward.py RUN --variants friction,nokicks,eval``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import mujoco
+import numpy as np
+from scipy.ndimage import gaussian_filter1d
+
+from imitwalk.balance.feedback import FeedbackLaw, TickPolicy
+from imitwalk.judge.protocol import load_protocol
+from imitwalk.judge.replay import OPEN_LOOP, load_run
+from imitwalk.parallel import run_parallel
+from imitwalk.retarget import Reference
+from imitwalk.robots import load_robot
+from imitwalk.sim.perturb import perturbed, train_seeds
+
+#: Accelerations are smoothed over this many ticks (σ), offsets clipped to this [rad].
+SMOOTH, CLIP = 2.0, 0.2
+
+
+def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarray, dt: float):
+    """``(T, n)`` target offsets [rad] so the nominal servos give the reference's torques.
+
+    Args:
+        robot: the robot; q_ref: ``(T, n)`` canonical joint targets [rad]; stance:
+            ``(T, 2)`` planned feet down (left, right); share: ``(T,)`` the left sole's
+            share of the load; dt: the control period [s].
+    """
+    m = robot.compile()
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    d = mujoco.MjData(m)
+    jid = [m.joint(j).id for j in robot.mj_joints]
+    qadr, dadr = m.jnt_qposadr[jid], m.jnt_dofadr[jid]
+    kp, kv = np.zeros(len(jid)), np.zeros(len(jid))
+    for a in range(m.nu):
+        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and m.actuator_trnid[a, 0] in jid:
+            i = jid.index(m.actuator_trnid[a, 0])
+            kp[i], kv[i] = m.actuator_gainprm[a, 0], -m.actuator_biasprm[a, 2]
+    soles = [m.site(robot.soles[s]).id for s in ("l", "r")]
+    T, nv = len(q_ref), m.nv
+    qdot = np.gradient(q_ref * robot.signs, dt, axis=0)  # (T, n) mj joint rates [rad/s]
+    qpos, qvel = np.zeros((T, m.nq)), np.zeros((T, nv))
+    jac = np.zeros((6, nv))
+    for t in range(T):
+        st = soles[0] if share[t] >= 0.5 else soles[1]
+        d.qpos[:] = robot.stand_qpos
+        d.qpos[:3], d.qpos[3:7] = (0.0, 0.0, 5.0), (1, 0, 0, 0)
+        d.qpos[qadr] = q_ref[t] * robot.signs
+        mujoco.mj_kinematics(m, d)
+        quat = np.zeros(4)  # the base turned so the stance sole is level (and faces +x)
+        mujoco.mju_mat2Quat(quat, d.site_xmat[st].reshape(3, 3).T.copy().ravel())
+        d.qpos[3:7] = quat
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        rows = []  # the soles planned down stay still (least squares with both down)
+        for j, s in enumerate(soles):
+            if stance[t, j] or s == st:
+                mujoco.mj_jacSite(m, d, jac[:3], jac[3:], s)
+                rows.append(jac.copy())
+        J = np.vstack(rows)
+        qvel[t, dadr] = qdot[t]
+        qvel[t, :6] = np.linalg.lstsq(J[:, :6], -J[:, dadr] @ qdot[t], rcond=None)[0]
+        qpos[t] = d.qpos
+    qacc = gaussian_filter1d(np.gradient(qvel, dt, axis=0), SMOOTH, axis=0, mode="nearest")
+    out = np.zeros_like(q_ref)
+    for t in range(T):
+        d.qpos[:], d.qvel[:], d.qacc[:] = qpos[t], qvel[t], qacc[t]
+        mujoco.mj_inverse(m, d)
+        b = d.qfrc_inverse.copy()
+        J = []
+        for s in soles:
+            mujoco.mj_jacSite(m, d, jac[:3], jac[3:], s)
+            J.append(jac.copy())
+        w = np.array([share[t], 1.0 - share[t]]) * stance[t] + 1e-6
+        A = np.hstack([J[0][:, :6].T, J[1][:, :6].T])  # (6, 12): base rows of Jᵀ
+        Winv = np.repeat(w, 6)
+        f = Winv * (A.T @ np.linalg.solve((A * Winv) @ A.T, b[:6]))
+        tau = b[dadr] - (np.vstack(J).T @ f)[dadr]
+        out[t] = (tau + kv * qvel[t, dadr]) / np.where(kp > 0, kp, np.inf) * robot.signs
+    return np.clip(out, -CLIP, CLIP)
+
+
+def plan_load(ref: Reference, scale: float, T: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(T, 2)`` planned feet down and ``(T,)`` the left sole's share of the load."""
+    plan = ref.plan_at(scale)
+    n0, nl = ref.starts.shape[1], ref.loops.shape[1]
+    rows = np.array([k if k < n0 else n0 + (k - n0) % nl for k in range(T)])
+    rows = np.minimum(rows, len(plan["com"]) - 1)
+    down = np.stack([plan["l_sole"][rows, 2], plan["r_sole"][rows, 2]], 1) <= 1e-4
+    yl, yr, yc = plan["l_sole"][rows, 1], plan["r_sole"][rows, 1], plan["com"][rows, 1]
+    share = np.clip((yc - yr) / np.maximum(yl - yr, 1e-6), 0.0, 1.0)
+    share = np.where(down[:, 0] & ~down[:, 1], 1.0, np.where(down[:, 1] & ~down[:, 0], 0.0, share))
+    return down, share
+
+
+class FeedforwardPolicy:
+    """A run's :class:`TickPolicy` with the servo offsets added to its targets."""
+
+    def __init__(self, ref, scale, laws, robot, seconds, fraction, hold=(1.0, 0.0)):
+        self.inner = TickPolicy(ref, scale, laws, robot.joint_names, 2 * seconds)
+        self.down, share = plan_load(ref, scale, len(self.inner.q_ref))
+        self.off = fraction * servo_offsets(robot, self.inner.q_ref, self.down, share, ref.dt)
+        self.inner.q_ref = self.inner.q_ref + self.off
+        self.hold, self.max_hold = hold[0], round(hold[1] / ref.dt)
+        self.i = self.held = 0
+
+    @property
+    def q0(self) -> np.ndarray:
+        return self.inner.q0
+
+    def __call__(self, k: int, obs) -> np.ndarray:
+        """The phase hold of ``bench/phase_hold.py``: before a planned lift-off the
+        reference waits while the lifting sole carries more than ``hold[0]`` of the load
+        (at most ``hold[1]`` s)."""
+        if k:
+            load = obs.foot_force.sum(axis=1)
+            share = load / max(float(load.sum()), 1e-9)
+            j = min(self.i, len(self.down) - 2)
+            lifting = self.down[j] & ~self.down[j + 1]
+            if np.any(lifting & (share > self.hold)) and self.held < self.max_hold:
+                self.held += 1
+            else:
+                self.held, self.i = 0, self.i + 1
+        return self.inner(self.i, obs)
+
+
+def _walk(job) -> tuple[bool, float | None, float, float]:
+    path, robot_name, scale, laws, options, seconds, fraction, hold = job
+    from imitwalk.sim.mujoco import make_plant, run
+
+    ref, robot = Reference.load(path), load_robot(robot_name)
+    policy = FeedforwardPolicy(ref, scale, laws, robot, seconds, fraction, hold)
+    ro = run(make_plant(robot, ref.sim_options(options)), policy, round(seconds / ref.dt))
+    distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
+    return bool(ro.fell), ro.fall_time, distance, float(np.abs(policy.off).max())
+
+
+def gain_law(text: str) -> FeedbackLaw:
+    """``channel:feature=gain`` items, comma-separated, as one law."""
+    items = [x.split("=") for x in text.split(",")]
+    pairs = [tuple(k.split(":")) for k, _ in items]
+    law = FeedbackLaw.zero(
+        tuple(dict.fromkeys(c for c, _ in pairs)), tuple(dict.fromkeys(f for _, f in pairs)), 0.15
+    )
+    for (c, f), (_, v) in zip(pairs, items, strict=True):
+        law = law.with_gain(c, f, float(v))
+    return law
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("source", help="a per-tick run folder, or a reference (.npz)")
+    ap.add_argument("--robot", default="hoap2")
+    ap.add_argument("--controller", default="learned")
+    ap.add_argument("--scale", type=float, default=0.3, help="with a reference")
+    ap.add_argument("--robots", type=int, default=40)
+    ap.add_argument("--first", type=int, default=300_000)
+    ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--variants", default="friction,nokicks,eval")
+    ap.add_argument("--fractions", default="0,1")
+    ap.add_argument("--gains", default=None, help="with a reference: channel:feature=gain,...")
+    ap.add_argument("--hold", default="1,0", help="phase hold threshold,max seconds (1,0: none)")
+    args = ap.parse_args()
+    robot = load_robot(args.robot)
+    hold = tuple(float(x) for x in args.hold.split(","))
+    if args.source.endswith(".npz"):
+        path, ref, scale = args.source, Reference.load(args.source), args.scale
+        laws = (gain_law(args.gains),) if args.gains else ()
+    else:
+        run = load_run(args.source)
+        path, ref, scale = run.path + "/reference.npz", run.ref, run.scale
+        laws = () if args.controller == OPEN_LOOP else tuple(run.laws[args.controller])
+    hard = load_protocol("hard")
+    protos = {
+        "friction": hard.only(("friction",)),
+        "nokicks": hard.only(tuple(f for f in hard.factors if f != "pushes")),
+        "hard": hard,
+        "eval": load_protocol("eval"),
+    }
+    summary = {}
+    for name in args.variants.split(","):
+        if name == "train":
+            options = [perturbed(s, ref.sim_options()) for s in train_seeds(args.robots)]
+        else:
+            p = protos[name]
+            options = [p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
+                       for s in range(args.robots)]  # fmt: skip
+        for text in args.fractions.split(","):
+            jobs = [(path, args.robot, scale, laws, o, args.seconds, float(text), hold)
+                    for o in options]  # fmt: skip
+            res = run_parallel(_walk, jobs)
+            times = sorted(round(t, 2) for f, t, *_ in res if f)
+            row = {
+                "variant": name,
+                "fraction": float(text),
+                "falls": len(times),
+                "fall_times_s": times,
+                "distance_m": round(float(np.mean([r[2] for r in res])), 2),
+                "offset_max_rad": round(float(np.max([r[3] for r in res])), 3),
+            }
+            summary[f"{name} {text}"] = len(times)
+            print(json.dumps(row), flush=True)
+    print(json.dumps({"source": args.source, "falls": summary}))
+
+
+if __name__ == "__main__":
+    main()
