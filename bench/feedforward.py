@@ -17,11 +17,12 @@ the reference needs on the *nominal* model (no sensor, no state of the simulatio
 controller (or open loop on a reference, with ``--gains`` as in ``bench/step_width.py``),
 on training robots (variant ``train``) or validation robots of hard's variants. Prints
 one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
-truth, for the figure only) and the largest offset [rad].
+truth, for the figure only) and the largest offset [rad]. With ``--sway``, instead, how
+the nominal robot's centre of mass follows the plan's sway in the first cycle.
 
 Usage: ``python bench/feedforward.py REF.npz --robot g1.json --scale 0.3 --robots 4
 --seconds 10 --variants train --fractions 0,0.5,1 [--gains ankle_pitch:gyro_y=0.05]``,
-or ``python bench/feedforward.py RUN --variants friction,nokicks,eval``.
+or ``python bench/feedforward.py RUN --variants friction,nokicks,eval``, or ``... --sway``.
 """
 
 from __future__ import annotations
@@ -162,6 +163,34 @@ def _walk(job) -> tuple[bool, float | None, float, float]:
     return bool(ro.fell), ro.fall_time, distance, float(np.abs(policy.off).max())
 
 
+def sway_follow(path: str, robot_name: str, scale: float, fraction: float) -> dict:
+    """How the nominal training robot follows its reference over the start-up's first
+    cycle (feet down), open loop: the knees' RMS error [°], and the centre of mass's
+    sideways peak-to-peak ÷ the plan's and its lag [s] (ground truth, for the diagnosis)."""
+    from imitwalk.sim.mujoco import MujocoPlant
+
+    ref, robot = Reference.load(path), load_robot(robot_name)
+    n = ref.loops.shape[1]
+    plan = ref.plan_at(scale)["com"][:n, 1]
+    policy = FeedforwardPolicy(ref, scale, (), robot, n * ref.dt, fraction)
+    plant = MujocoPlant(robot, perturbed(train_seeds(1)[0], ref.sim_options()))
+    q_ref = policy.inner.q_ref - policy.off  # the reference itself
+    knees = [robot.joint_names.index(j) for j in ("l_knee", "r_knee")]
+    obs, com, err = plant.reset(policy.q0), [], []
+    for t in range(n):
+        plant.command(policy(t, obs))
+        obs = plant.step()
+        com.append(plant.data.subtree_com[0][1])
+        err.append(obs.joints[knees] - q_ref[t + 1, knees])
+    y = np.array(com) - com[0]
+    return {
+        "fraction": fraction,
+        "knee_rms_deg": round(float(np.degrees(np.sqrt(np.mean(np.square(err))))), 2),
+        "sway_measured_over_planned": round(float(np.ptp(y) / np.ptp(plan)), 2),
+        "lag_s": round(float((np.argmin(y) - np.argmin(plan)) * ref.dt), 2),
+    }
+
+
 def gain_law(text: str) -> FeedbackLaw:
     """``channel:feature=gain`` items, comma-separated, as one law."""
     items = [x.split("=") for x in text.split(",")]
@@ -186,6 +215,7 @@ def main() -> None:
     ap.add_argument("--variants", default="friction,nokicks,eval")
     ap.add_argument("--fractions", default="0,1")
     ap.add_argument("--gains", default=None, help="with a reference: channel:feature=gain,...")
+    ap.add_argument("--sway", action="store_true", help="only how the body follows its sway")
     ap.add_argument("--hold", default="1,0", help="phase hold threshold,max seconds (1,0: none)")
     args = ap.parse_args()
     robot = load_robot(args.robot)
@@ -204,6 +234,10 @@ def main() -> None:
         "hard": hard,
         "eval": load_protocol("eval"),
     }
+    if args.sway:
+        for text in args.fractions.split(","):
+            print(json.dumps(sway_follow(path, args.robot, scale, float(text))))
+        return
     summary = {}
     for name in args.variants.split(","):
         if name == "train":
