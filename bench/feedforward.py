@@ -13,9 +13,10 @@ the reference needs on the *nominal* model (no sensor, no state of the simulatio
 - the soles' wrenches are what the base's six rows need (one sole: solved; both:
   least norm weighted by each sole's share of the plan's load), and ``τ`` the rest.
 
-``--fraction`` scales the offset (0: the reference as it is). The walk is the run's
-controller (or open loop on a reference, with ``--gains`` as in ``bench/step_width.py``),
-on training robots (variant ``train``) or validation robots of hard's variants. Prints
+``--fractions`` scale the offset (0: the reference as it is); ``--hold`` adds the phase
+hold of ``bench/phase_hold.py``. The walk is the run's controller, or open loop on a
+reference plus the laws of ``--gains channel:feature=gain,...``, on training robots
+(variant ``train``) or validation robots of hard's variants and eval's. Prints
 one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
 truth, for the figure only) and the largest offset [rad]. With ``--sway``, instead, how
 the nominal robot's centre of mass follows the plan's sway in the first cycle.
