@@ -16,7 +16,8 @@ the reference needs on the *nominal* model (no sensor, no state of the simulatio
 ``--fractions`` scale the offset (0: the reference as it is); ``--hold`` adds the phase
 hold of ``bench/phase_hold.py``. The walk is the run's controller, or open loop on a
 reference plus the laws of ``--gains channel:feature=gain,...``, on training robots
-(variant ``train``) or validation robots of hard's variants and eval's. Prints
+(variant ``train``) or validation robots of hard's variants, eval's and bullet's (on
+Bullet). Prints
 one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
 truth, for the figure only) and the largest offset [rad]. With ``--sway``, instead, how
 the nominal robot's centre of mass follows the plan's sway in the first cycle.
@@ -154,12 +155,13 @@ class FeedforwardPolicy:
 
 
 def _walk(job) -> tuple[bool, float | None, float, float]:
-    path, robot_name, scale, laws, options, seconds, fraction, hold = job
+    path, robot_name, scale, laws, options, seconds, fraction, hold, engine = job
     from imitwalk.sim.mujoco import make_plant, run
 
     ref, robot = Reference.load(path), load_robot(robot_name)
     policy = FeedforwardPolicy(ref, scale, laws, robot, seconds, fraction, hold)
-    ro = run(make_plant(robot, ref.sim_options(options)), policy, round(seconds / ref.dt))
+    plant = make_plant(robot, ref.sim_options(options), engine)
+    ro = run(plant, policy, round(seconds / ref.dt))
     distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
     return bool(ro.fell), ro.fall_time, distance, float(np.abs(policy.off).max())
 
@@ -234,6 +236,7 @@ def main() -> None:
         "nokicks": hard.only(tuple(f for f in hard.factors if f != "pushes")),
         "hard": hard,
         "eval": load_protocol("eval"),
+        "bullet": load_protocol("bullet"),
     }
     if args.sway:
         for text in args.fractions.split(","):
@@ -241,6 +244,7 @@ def main() -> None:
         return
     summary = {}
     for name in args.variants.split(","):
+        engine = "mujoco" if name == "train" else protos[name].engine
         if name == "train":
             options = [perturbed(s, ref.sim_options()) for s in train_seeds(args.robots)]
         else:
@@ -248,7 +252,7 @@ def main() -> None:
             options = [p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
                        for s in range(args.robots)]  # fmt: skip
         for text in args.fractions.split(","):
-            jobs = [(path, args.robot, scale, laws, o, args.seconds, float(text), hold)
+            jobs = [(path, args.robot, scale, laws, o, args.seconds, float(text), hold, engine)
                     for o in options]  # fmt: skip
             res = run_parallel(_walk, jobs)
             times = sorted(round(t, 2) for f, t, *_ in res if f)
