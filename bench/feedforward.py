@@ -15,7 +15,8 @@ the reference needs on the *nominal* model (no sensor, no state of the simulatio
 
 ``--fractions`` scale the offset (0: the reference as it is); ``--hold`` adds the phase
 hold of ``bench/phase_hold.py``. The walk is the run's controller, or open loop on a
-reference plus the laws of ``--gains channel:feature=gain,...``, on training robots
+reference plus the learner's law with the gains of ``--gains pitch=G,roll=G,heading=G``
+(a missing one is 0), on training robots
 (variant ``train``) or validation robots of hard's variants, eval's and bullet's (on
 Bullet). Prints
 one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
@@ -23,7 +24,7 @@ truth, for the figure only) and the largest offset [rad]. With ``--sway``, inste
 the nominal robot's centre of mass follows the plan's sway in the first cycle.
 
 Usage: ``python bench/feedforward.py REF.npz --robot g1.json --scale 0.3 --robots 4
---seconds 10 --variants train --fractions 0,0.5,1 [--gains ankle_pitch:gyro_y=0.05]``,
+--seconds 10 --variants train --fractions 0,0.5,1 [--gains pitch=0.05]``,
 or ``python bench/feedforward.py RUN --variants friction,nokicks,eval``, or ``... --sway``.
 """
 
@@ -36,7 +37,9 @@ import mujoco
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from imitwalk.balance.feedback import FeedbackLaw, TickPolicy
+from imitwalk.balance.feedback import TickPolicy
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law
 from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.replay import OPEN_LOOP, load_run
 from imitwalk.parallel import run_parallel
@@ -70,7 +73,7 @@ def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarra
     T, nv = len(q_ref), m.nv
     qdot = np.gradient(q_ref * robot.signs, dt, axis=0)  # (T, n) mj joint rates [rad/s]
     qpos, qvel = np.zeros((T, m.nq)), np.zeros((T, nv))
-    jac = np.zeros((6, nv))
+    jacs = np.zeros((T, 2, 6, nv))  # each sole's Jacobian, position rows then rotation
     for t in range(T):
         st = soles[0] if share[t] >= 0.5 else soles[1]
         d.qpos[:] = robot.stand_qpos
@@ -82,12 +85,10 @@ def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarra
         d.qpos[3:7] = quat
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
-        rows = []  # the soles planned down stay still (least squares with both down)
         for j, s in enumerate(soles):
-            if stance[t, j] or s == st:
-                mujoco.mj_jacSite(m, d, jac[:3], jac[3:], s)
-                rows.append(jac.copy())
-        J = np.vstack(rows)
+            mujoco.mj_jacSite(m, d, jacs[t, j, :3], jacs[t, j, 3:], s)
+        # the soles planned down stay still (least squares with both down)
+        J = np.vstack([jacs[t, j] for j, s in enumerate(soles) if stance[t, j] or s == st])
         qvel[t, dadr] = qdot[t]
         qvel[t, :6] = np.linalg.lstsq(J[:, :6], -J[:, dadr] @ qdot[t], rcond=None)[0]
         qpos[t] = d.qpos
@@ -96,16 +97,12 @@ def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarra
     for t in range(T):
         d.qpos[:], d.qvel[:], d.qacc[:] = qpos[t], qvel[t], qacc[t]
         mujoco.mj_inverse(m, d)
-        b = d.qfrc_inverse.copy()
-        J = []
-        for s in soles:
-            mujoco.mj_jacSite(m, d, jac[:3], jac[3:], s)
-            J.append(jac.copy())
+        b, J = d.qfrc_inverse.copy(), jacs[t].reshape(12, nv)
         w = np.array([share[t], 1.0 - share[t]]) * stance[t] + 1e-6
-        A = np.hstack([J[0][:, :6].T, J[1][:, :6].T])  # (6, 12): base rows of Jᵀ
+        A = J[:, :6].T  # (6, 12): the base's rows of Jᵀ
         Winv = np.repeat(w, 6)
         f = Winv * (A.T @ np.linalg.solve((A * Winv) @ A.T, b[:6]))
-        tau = b[dadr] - (np.vstack(J).T @ f)[dadr]
+        tau = b[dadr] - (J.T @ f)[dadr]
         out[t] = (tau + kv * qvel[t, dadr]) / np.where(kp > 0, kp, np.inf) * robot.signs
     return np.clip(out, -CLIP, CLIP)
 
@@ -113,9 +110,7 @@ def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarra
 def plan_load(ref: Reference, scale: float, T: int) -> tuple[np.ndarray, np.ndarray]:
     """``(T, 2)`` planned feet down and ``(T,)`` the left sole's share of the load."""
     plan = ref.plan_at(scale)
-    n0, nl = ref.starts.shape[1], ref.loops.shape[1]
-    rows = np.array([k if k < n0 else n0 + (k - n0) % nl for k in range(T)])
-    rows = np.minimum(rows, len(plan["com"]) - 1)
+    rows = ref.loop_index(np.arange(T))[0]
     down = np.stack([plan["l_sole"][rows, 2], plan["r_sole"][rows, 2]], 1) <= 1e-4
     yl, yr, yc = plan["l_sole"][rows, 1], plan["r_sole"][rows, 1], plan["com"][rows, 1]
     share = np.clip((yc - yr) / np.maximum(yl - yr, 1e-6), 0.0, 1.0)
@@ -123,14 +118,22 @@ def plan_load(ref: Reference, scale: float, T: int) -> tuple[np.ndarray, np.ndar
     return down, share
 
 
-class FeedforwardPolicy:
-    """A run's :class:`TickPolicy` with the servo offsets added to its targets."""
+def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np.ndarray:
+    """``(T, n)`` :func:`servo_offsets` of the reference at ``scale`` for ``2 × seconds``
+    (the ticks a :class:`FeedforwardPolicy` may reach while its phase holds)."""
+    q = ref.trajectory(scale, 2 * seconds)
+    down, share = plan_load(ref, scale, len(q))
+    return servo_offsets(robot, q, down, share, ref.dt)
 
-    def __init__(self, ref, scale, laws, robot, seconds, fraction, hold=(1.0, 0.0)):
+
+class FeedforwardPolicy:
+    """A run's :class:`TickPolicy` with ``offsets`` ``(T, n)`` [rad] added to its targets
+    (``T`` the ticks of ``2 × seconds``) and the optional phase hold."""
+
+    def __init__(self, ref, scale, laws, robot, seconds, offsets, hold=(1.0, 0.0)):
         self.inner = TickPolicy(ref, scale, laws, robot.joint_names, 2 * seconds)
-        self.down, share = plan_load(ref, scale, len(self.inner.q_ref))
-        self.off = fraction * servo_offsets(robot, self.inner.q_ref, self.down, share, ref.dt)
-        self.inner.q_ref = self.inner.q_ref + self.off
+        self.down = plan_load(ref, scale, len(self.inner.q_ref))[0]
+        self.inner.q_ref = self.inner.q_ref + offsets
         self.hold, self.max_hold = hold[0], round(hold[1] / ref.dt)
         self.i = self.held = 0
 
@@ -155,29 +158,28 @@ class FeedforwardPolicy:
 
 
 def _walk(job) -> tuple[bool, float | None, float, float]:
-    path, robot_name, scale, laws, options, seconds, fraction, hold, engine = job
+    path, robot_name, scale, laws, options, seconds, offsets, hold, engine = job
     from imitwalk.sim.mujoco import make_plant, run
 
     ref, robot = Reference.load(path), load_robot(robot_name)
-    policy = FeedforwardPolicy(ref, scale, laws, robot, seconds, fraction, hold)
+    policy = FeedforwardPolicy(ref, scale, laws, robot, seconds, offsets, hold)
     plant = make_plant(robot, ref.sim_options(options), engine)
     ro = run(plant, policy, round(seconds / ref.dt))
     distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
-    return bool(ro.fell), ro.fall_time, distance, float(np.abs(policy.off).max())
+    return bool(ro.fell), ro.fall_time, distance
 
 
-def sway_follow(path: str, robot_name: str, scale: float, fraction: float) -> dict:
+def sway_follow(ref: Reference, robot, scale: float, offsets: np.ndarray) -> dict:
     """How the nominal training robot follows its reference over the start-up's first
     cycle (feet down), open loop: the knees' RMS error [°], and the centre of mass's
     sideways peak-to-peak ÷ the plan's and its lag [s] (ground truth, for the diagnosis)."""
     from imitwalk.sim.mujoco import MujocoPlant
 
-    ref, robot = Reference.load(path), load_robot(robot_name)
     n = ref.loops.shape[1]
     plan = ref.plan_at(scale)["com"][:n, 1]
-    policy = FeedforwardPolicy(ref, scale, (), robot, n * ref.dt, fraction)
+    policy = FeedforwardPolicy(ref, scale, (), robot, n * ref.dt, offsets[: 2 * n])
     plant = MujocoPlant(robot, perturbed(train_seeds(1)[0], ref.sim_options()))
-    q_ref = policy.inner.q_ref - policy.off  # the reference itself
+    q_ref = ref.trajectory(scale, 2 * n * ref.dt)
     knees = [robot.joint_names.index(j) for j in ("l_knee", "r_knee")]
     obs, com, err = plant.reset(policy.q0), [], []
     for t in range(n):
@@ -187,23 +189,10 @@ def sway_follow(path: str, robot_name: str, scale: float, fraction: float) -> di
         err.append(obs.joints[knees] - q_ref[t + 1, knees])
     y = np.array(com) - com[0]
     return {
-        "fraction": fraction,
         "knee_rms_deg": round(float(np.degrees(np.sqrt(np.mean(np.square(err))))), 2),
         "sway_measured_over_planned": round(float(np.ptp(y) / np.ptp(plan)), 2),
         "lag_s": round(float((np.argmin(y) - np.argmin(plan)) * ref.dt), 2),
     }
-
-
-def gain_law(text: str) -> FeedbackLaw:
-    """``channel:feature=gain`` items, comma-separated, as one law."""
-    items = [x.split("=") for x in text.split(",")]
-    pairs = [tuple(k.split(":")) for k, _ in items]
-    law = FeedbackLaw.zero(
-        tuple(dict.fromkeys(c for c, _ in pairs)), tuple(dict.fromkeys(f for _, f in pairs)), 0.15
-    )
-    for (c, f), (_, v) in zip(pairs, items, strict=True):
-        law = law.with_gain(c, f, float(v))
-    return law
 
 
 def main() -> None:
@@ -217,7 +206,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--variants", default="friction,nokicks,eval")
     ap.add_argument("--fractions", default="0,1")
-    ap.add_argument("--gains", default=None, help="with a reference: channel:feature=gain,...")
+    ap.add_argument("--gains", default=None, help="with a reference: pitch=G,roll=G,heading=G")
     ap.add_argument("--sway", action="store_true", help="only how the body follows its sway")
     ap.add_argument("--hold", default="1,0", help="phase hold threshold,max seconds (1,0: none)")
     args = ap.parse_args()
@@ -225,7 +214,11 @@ def main() -> None:
     hold = tuple(float(x) for x in args.hold.split(","))
     if args.source.endswith(".npz"):
         path, ref, scale = args.source, Reference.load(args.source), args.scale
-        laws = (gain_law(args.gains),) if args.gains else ()
+        gains = dict(x.split("=") for x in args.gains.split(",")) if args.gains else None
+        valid = [name for name, *_ in TRIAL_GAINS]
+        if gains and set(gains) - set(valid):
+            ap.error(f"--gains names one of {', '.join(valid)}; got {', '.join(gains)}")
+        laws = (feedback_law(TickLearnConfig(), gains),) if gains else ()  # the learner's law
     else:
         run = load_run(args.source)
         path, ref, scale = run.path + "/reference.npz", run.ref, run.scale
@@ -239,9 +232,12 @@ def main() -> None:
         "bullet": load_protocol("bullet"),
     }
     if args.sway:
+        offsets = reference_offsets(ref, robot, scale, ref.loops.shape[1] * ref.dt)
         for text in args.fractions.split(","):
-            print(json.dumps(sway_follow(path, args.robot, scale, float(text))))
+            out = sway_follow(ref, robot, scale, float(text) * offsets)
+            print(json.dumps({"fraction": float(text), **out}))
         return
+    offsets = reference_offsets(ref, robot, scale, args.seconds)  # at fraction 1
     summary = {}
     for name in args.variants.split(","):
         engine = "mujoco" if name == "train" else protos[name].engine
@@ -252,7 +248,8 @@ def main() -> None:
             options = [p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
                        for s in range(args.robots)]  # fmt: skip
         for text in args.fractions.split(","):
-            jobs = [(path, args.robot, scale, laws, o, args.seconds, float(text), hold, engine)
+            off = float(text) * offsets
+            jobs = [(path, args.robot, scale, laws, o, args.seconds, off, hold, engine)
                     for o in options]  # fmt: skip
             res = run_parallel(_walk, jobs)
             times = sorted(round(t, 2) for f, t, *_ in res if f)
@@ -262,7 +259,7 @@ def main() -> None:
                 "falls": len(times),
                 "fall_times_s": times,
                 "distance_m": round(float(np.mean([r[2] for r in res])), 2),
-                "offset_max_rad": round(float(np.max([r[3] for r in res])), 3),
+                "offset_max_rad": round(float(np.abs(off).max()), 3),
             }
             summary[f"{name} {text}"] = len(times)
             print(json.dumps(row), flush=True)
