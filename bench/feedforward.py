@@ -1,17 +1,9 @@
-"""A lead, not a product option: the servos' sag taken out of the reference by inverse dynamics.
+"""The servos' sag taken out of the reference (:mod:`imitwalk.retarget.feedforward`),
+walked at fixed fractions, with the phase hold (a lead, not in the product).
 
-A position servo holds its joint only where its torque ``kp·(q_target − q) − kv·q̇`` is
-what the motion needs, so a robot played its reference sags and lags: in single support
-G1's stance hip roll carries about m·g·(half the stance width) ≈ 39 Nm, 4.5° at kp 500.
-This bench adds to every joint target the offset ``(τ + kv·q̇_ref)/kp`` (Craig's
-computed-torque feedforward, through a position servo), where ``τ`` is the joint torque
-the reference needs on the *nominal* model (no sensor, no state of the simulation):
-
-- the floating base is placed every tick so that the planned stance sole stays flat and
-  still (its velocity from the sole's Jacobian, its acceleration by finite differences);
-- ``mj_inverse`` gives the generalised forces of that motion, contacts off;
-- the soles' wrenches are what the base's six rows need (one sole: solved; both:
-  least norm weighted by each sole's share of the plan's load), and ``τ`` the rest.
+The product's learner picks the feedforward's fraction by trials
+(``trials.feedforward``); this bench walks chosen fractions side by side on validation
+robots, and adds what the product lacks: the phase hold.
 
 ``--fractions`` scale the offset (0: the reference as it is); ``--hold`` adds the phase
 hold of ``bench/phase_hold.py``. The walk is the run's controller, or open loop on a
@@ -33,9 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 
-import mujoco
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
 
 from imitwalk.balance.feedback import TickPolicy
 from imitwalk.balance.tickconfig import TickLearnConfig
@@ -44,86 +34,9 @@ from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.replay import OPEN_LOOP, load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget import Reference
+from imitwalk.retarget.feedforward import reference_offsets
 from imitwalk.robots import load_robot
 from imitwalk.sim.perturb import perturbed, train_seeds
-
-#: Accelerations are smoothed over this many ticks (σ), offsets clipped to this [rad].
-SMOOTH, CLIP = 2.0, 0.2
-
-
-def servo_offsets(robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarray, dt: float):
-    """``(T, n)`` target offsets [rad] so the nominal servos give the reference's torques.
-
-    Args:
-        robot: the robot; q_ref: ``(T, n)`` canonical joint targets [rad]; stance:
-            ``(T, 2)`` planned feet down (left, right); share: ``(T,)`` the left sole's
-            share of the load; dt: the control period [s].
-    """
-    m = robot.compile()
-    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
-    d = mujoco.MjData(m)
-    jid = [m.joint(j).id for j in robot.mj_joints]
-    qadr, dadr = m.jnt_qposadr[jid], m.jnt_dofadr[jid]
-    kp, kv = np.zeros(len(jid)), np.zeros(len(jid))
-    for a in range(m.nu):
-        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and m.actuator_trnid[a, 0] in jid:
-            i = jid.index(m.actuator_trnid[a, 0])
-            kp[i], kv[i] = m.actuator_gainprm[a, 0], -m.actuator_biasprm[a, 2]
-    soles = [m.site(robot.soles[s]).id for s in ("l", "r")]
-    T, nv = len(q_ref), m.nv
-    qdot = np.gradient(q_ref * robot.signs, dt, axis=0)  # (T, n) mj joint rates [rad/s]
-    qpos, qvel = np.zeros((T, m.nq)), np.zeros((T, nv))
-    jacs = np.zeros((T, 2, 6, nv))  # each sole's Jacobian, position rows then rotation
-    for t in range(T):
-        st = soles[0] if share[t] >= 0.5 else soles[1]
-        d.qpos[:] = robot.stand_qpos
-        d.qpos[:3], d.qpos[3:7] = (0.0, 0.0, 5.0), (1, 0, 0, 0)
-        d.qpos[qadr] = q_ref[t] * robot.signs
-        mujoco.mj_kinematics(m, d)
-        quat = np.zeros(4)  # the base turned so the stance sole is level (and faces +x)
-        mujoco.mju_mat2Quat(quat, d.site_xmat[st].reshape(3, 3).T.copy().ravel())
-        d.qpos[3:7] = quat
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        for j, s in enumerate(soles):
-            mujoco.mj_jacSite(m, d, jacs[t, j, :3], jacs[t, j, 3:], s)
-        # the soles planned down stay still (least squares with both down)
-        J = np.vstack([jacs[t, j] for j, s in enumerate(soles) if stance[t, j] or s == st])
-        qvel[t, dadr] = qdot[t]
-        qvel[t, :6] = np.linalg.lstsq(J[:, :6], -J[:, dadr] @ qdot[t], rcond=None)[0]
-        qpos[t] = d.qpos
-    qacc = gaussian_filter1d(np.gradient(qvel, dt, axis=0), SMOOTH, axis=0, mode="nearest")
-    out = np.zeros_like(q_ref)
-    for t in range(T):
-        d.qpos[:], d.qvel[:], d.qacc[:] = qpos[t], qvel[t], qacc[t]
-        mujoco.mj_inverse(m, d)
-        b, J = d.qfrc_inverse.copy(), jacs[t].reshape(12, nv)
-        w = np.array([share[t], 1.0 - share[t]]) * stance[t] + 1e-6
-        A = J[:, :6].T  # (6, 12): the base's rows of Jᵀ
-        Winv = np.repeat(w, 6)
-        f = Winv * (A.T @ np.linalg.solve((A * Winv) @ A.T, b[:6]))
-        tau = b[dadr] - (J.T @ f)[dadr]
-        out[t] = (tau + kv * qvel[t, dadr]) / np.where(kp > 0, kp, np.inf) * robot.signs
-    return np.clip(out, -CLIP, CLIP)
-
-
-def plan_load(ref: Reference, scale: float, T: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(T, 2)`` planned feet down and ``(T,)`` the left sole's share of the load."""
-    plan = ref.plan_at(scale)
-    rows = ref.loop_index(np.arange(T))[0]
-    down = np.stack([plan["l_sole"][rows, 2], plan["r_sole"][rows, 2]], 1) <= 1e-4
-    yl, yr, yc = plan["l_sole"][rows, 1], plan["r_sole"][rows, 1], plan["com"][rows, 1]
-    share = np.clip((yc - yr) / np.maximum(yl - yr, 1e-6), 0.0, 1.0)
-    share = np.where(down[:, 0] & ~down[:, 1], 1.0, np.where(down[:, 1] & ~down[:, 0], 0.0, share))
-    return down, share
-
-
-def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np.ndarray:
-    """``(T, n)`` :func:`servo_offsets` of the reference at ``scale`` for ``2 × seconds``
-    (the ticks a :class:`FeedforwardPolicy` may reach while its phase holds)."""
-    q = ref.trajectory(scale, 2 * seconds)
-    down, share = plan_load(ref, scale, len(q))
-    return servo_offsets(robot, q, down, share, ref.dt)
 
 
 class FeedforwardPolicy:
@@ -131,9 +44,9 @@ class FeedforwardPolicy:
     (``T`` the ticks of ``2 × seconds``) and the optional phase hold."""
 
     def __init__(self, ref, scale, laws, robot, seconds, offsets, hold=(1.0, 0.0)):
-        self.inner = TickPolicy(ref, scale, laws, robot.joint_names, 2 * seconds)
-        self.down = plan_load(ref, scale, len(self.inner.q_ref))[0]
-        self.inner.q_ref = self.inner.q_ref + offsets
+        names = robot.joint_names
+        self.inner = TickPolicy(ref, scale, laws, names, 2 * seconds, offsets=offsets)
+        self.down = ref.planned_load(scale, len(self.inner.q_ref))[0]
         self.hold, self.max_hold = hold[0], round(hold[1] / ref.dt)
         self.i = self.held = 0
 
@@ -232,12 +145,12 @@ def main() -> None:
         "bullet": load_protocol("bullet"),
     }
     if args.sway:
-        offsets = reference_offsets(ref, robot, scale, ref.loops.shape[1] * ref.dt)
+        offsets = reference_offsets(ref, robot, scale, 2 * ref.loops.shape[1] * ref.dt)
         for text in args.fractions.split(","):
             out = sway_follow(ref, robot, scale, float(text) * offsets)
             print(json.dumps({"fraction": float(text), **out}))
         return
-    offsets = reference_offsets(ref, robot, scale, args.seconds)  # at fraction 1
+    offsets = reference_offsets(ref, robot, scale, 2 * args.seconds)  # at fraction 1
     summary = {}
     for name in args.variants.split(","):
         engine = "mujoco" if name == "train" else protos[name].engine

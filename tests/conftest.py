@@ -23,7 +23,7 @@ TINY = [
 ]
 
 #: Settings of a tiny per-tick learning run (:mod:`imitwalk.balance.ticklearn`): scales 0.8 and 1,
-#: two training robots x 6 s, two candidates per trial-picked gain on two robots x 6 s.
+#: two training robots x 6 s, two candidates per trial-picked setting on two robots x 6 s.
 TICK = [
     "start=0.8",
     "step=0.2",
@@ -33,6 +33,7 @@ TICK = [
     "trials.seconds=6",
     "trials.heading_robots=2",
     "trials.heading_seconds=6",
+    "trials.feedforward=0,0.5",
     "trials.pitch=0,0.1",
     "trials.roll=0,0.1",
     "trials.heading=0,0.3",

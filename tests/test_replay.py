@@ -36,6 +36,26 @@ def test_a_per_tick_run_builds_learned_feedback_fixed_and_open_loop(tick_run, ro
         np.testing.assert_array_equal(policy.q_ref, lr.ref.trajectory(lr.scale, 4.0))
 
 
+def test_the_learned_controllers_add_the_kept_feedforward(tick_run, robot):
+    from dataclasses import replace
+
+    from imitwalk.retarget.feedforward import reference_offsets
+
+    lr = load_run(tick_run)
+    assert lr.settings == lr.metrics.reference_settings
+    lr = replace(lr, settings={"feedforward": 0.5, "wait": 0.0})
+    off = reference_offsets(lr.ref, robot, lr.scale, 4.0)
+    for name in ("learned", "feedback", "fixed"):
+        policy = lr.policy(name, robot, seconds=4.0)
+        want = 0.0 if name == "fixed" else 0.5  # the hand-set baseline plays it as it is
+        np.testing.assert_allclose(policy.q_cmd, policy.q_ref + want * off)
+        np.testing.assert_array_equal(policy.q_ref, lr.ref.trajectory(lr.scale, 4.0))
+    # a law equal to another's is its twin only with the same feedforward
+    twin = replace(lr, laws={**lr.laws, "fixed": lr.laws["feedback"]})
+    assert twin.twin("fixed") == "fixed"
+    assert replace(twin, settings=None).twin("fixed") in ("learned", "feedback")
+
+
 def test_open_loop_is_the_reference_played_as_it_is(tick_run, robot):
     lr = load_run(tick_run)
     q = lr.ref.trajectory(0.8, 3.0)

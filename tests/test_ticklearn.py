@@ -62,10 +62,17 @@ def test_a_tiny_run_writes_its_folder(tick_run):
     for name, value in m["feedback_gains"].items():
         assert value in getattr(cfg.trials, name)
     assert m["trust"] in cfg.lqr.trust
+    assert list(m["reference_settings"]) == ["feedforward", "wait"]
+    for name, value in m["reference_settings"].items():
+        assert value in getattr(cfg.trials, name)
     assert m["scale_reached"] in cfg.scales() and m["scales_passed"] == sorted(m["scales_passed"])
     log = rd.read_log()
-    assert [e["stage"] for e in log[:3]] == ["trials"] * 3 and log[-1]["stage"] == "trust"
-    for entry, (name, channel, feature, _) in zip(log, TRIAL_GAINS, strict=False):
+    assert [e["stage"] for e in log[:5]] == ["trials"] * 5 and log[-1]["stage"] == "trust"
+    # how the reference is played first, with no feedback, then the gains
+    for entry, name in zip(log, ("feedforward", "wait"), strict=False):
+        assert (entry["gain"], entry["kept"]) == (name, m["reference_settings"][name])
+        assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
+    for entry, (name, channel, feature, _) in zip(log[2:], TRIAL_GAINS, strict=False):
         assert (entry["gain"], entry["channel"], entry["feature"]) == (name, channel, feature)
         assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
         kept = next(r for r in entry["table"] if r["value"] == entry["kept"])
@@ -110,7 +117,7 @@ def test_the_controllers_a_run_builds(tick_run):
     assert fixed.gain("ankle_pitch", "gyro_y") == 0.05
 
 
-@pytest.mark.parametrize(("line", "stage"), [(2, "trials"), (8, "trust")])
+@pytest.mark.parametrize(("line", "stage"), [(3, "trials"), (10, "trust")])
 def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp_path, line, stage):
     ref = Reference.load(tick_reference)
     cut, resumed = _cut_and_resume(ref, robot, tmp_path / "cut", line)
@@ -125,7 +132,7 @@ def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp
 def cut_in_schedule(tick_reference, robot, tmp_path_factory):
     """A run interrupted in its second schedule iteration, resumed."""
     out = tmp_path_factory.mktemp("cut") / "run"
-    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 5)
+    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 7)
     assert cut["stage"] == "schedule" and cut["iteration"] == 1
     return out, resumed
 

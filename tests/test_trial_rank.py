@@ -49,3 +49,15 @@ def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit()
     assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 9.0), (-0.5, 1.0))]) == 0.0
     assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 19.0), (-0.5, 15.0))]) == -0.5
     assert pick([(0.0, _walks(0, yaw=19.0)), (-0.5, _walks(1, yaw=1.0))]) == 0.0  # falls first
+
+
+def test_where_every_robot_fell_the_longest_walked_wins():
+    def fell_at(t: float) -> Trial:
+        return Trial([TickResult(j, True, t, t, 0.1, 1.0, float("inf")) for j in range(4)])
+
+    table = [(0.0, fell_at(2.2)), (0.5, fell_at(2.3)), (1.0, fell_at(6.0))]
+    assert min(table, key=lambda row: row[1].rank(row[0]))[0] == 1.0
+    # but a robot that stays up outranks any fall time, and with one up the walk's
+    # length does not count
+    table += [(2.0, _walks(3, robots=4)), (3.0, _walks(3, robots=4))]
+    assert min(table, key=lambda row: row[1].rank(row[0]))[0] == 2.0

@@ -35,7 +35,7 @@ def _json_default(v):
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
 
 
-_TICK_ONLY = ("trial_falls_at_top", "feedback_gains", "trust")
+_TICK_ONLY = ("trial_falls_at_top", "feedback_gains", "trust", "reference_settings")
 _FAITHFUL_ONLY = ("variant", "gait")
 
 
@@ -53,6 +53,10 @@ class LearnSummary:
         trial_falls_at_top: ``tick``: falls of the kept law's trials at the top scale.
         feedback_gains: ``tick``: the gains the trials kept, by channel.
         trust: ``tick``: the fraction of the model-based law kept (0: none).
+        reference_settings: ``tick``: how the trials chose to play the reference, by
+            name: ``feedforward``, the fraction of the servo feedforward added
+            (:mod:`imitwalk.retarget.feedforward`), and ``wait``, the load share at which
+            its clock waits before a lift-off (0 or absent: none).
         variant: ``faithful``: its variant; gait: ``faithful``: its gait model's report.
     """
 
@@ -66,6 +70,7 @@ class LearnSummary:
     trial_falls_at_top: int | None = None
     feedback_gains: dict | None = None
     trust: float | None = None
+    reference_settings: dict | None = None
     variant: str | None = None
     gait: dict | None = None
 

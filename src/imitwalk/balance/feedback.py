@@ -14,6 +14,12 @@ matrix for every phase (from :mod:`imitwalk.balance.lqr`), or one for all (picke
 :mod:`imitwalk.balance.ticklearn`). Several laws add up (the learned one on top of the
 trial-picked one). During learning, piecewise-constant exploration noise is added to
 the last law's ``a``, and every tick's phase, features and that ``a`` are recorded.
+
+Two optional parts are the reference's, not feedback: a servo feedforward added to
+``q_ref`` (``offsets``, :mod:`imitwalk.retarget.feedforward`), and the phase wait (``wait``,
+eq. 9's phase advance made by the sole forces): before a planned lift-off the reference's
+clock waits while the sole about to lift still carries more than ``wait`` of the
+measured load, at most :data:`MAX_WAIT_S` per lift-off.
 """
 
 from __future__ import annotations
@@ -27,7 +33,10 @@ from imitwalk.balance.estimator import StateEstimator
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
 
-__all__ = ["Episode", "FeedbackLaw", "TickPolicy"]
+__all__ = ["MAX_WAIT_S", "Episode", "FeedbackLaw", "TickPolicy"]
+
+#: The longest the reference's clock waits at one lift-off [s].
+MAX_WAIT_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -150,7 +159,12 @@ class TickPolicy:
         joint_names: the robot's roles (for the channel maps); seconds: how long the
             walk runs [s]; explore: exploration amplitude [rad] on every channel of the
             last law (0: none); hold: ticks each exploration draw is held; seed: its
-            random stream.
+            random stream; offsets: ``(T', n)`` [rad] added to every target, ``T'`` the
+            ticks of :meth:`horizon` (the servo feedforward of
+            :func:`imitwalk.retarget.feedforward.reference_offsets`; ``None``: none);
+            wait: the load share [0, 1) above which the reference waits before a lift-off
+            (0: it never waits). ``q_ref`` ``(T, n)`` stays the reference for ``seconds``
+            (what a walk is measured against).
     """
 
     def __init__(
@@ -163,10 +177,18 @@ class TickPolicy:
         explore: float = 0.0,
         hold: int = 8,
         seed=0,
+        offsets: np.ndarray | None = None,
+        wait: float = 0.0,
     ):
         self.laws = tuple(laws)
         self.q_ref = ref.trajectory(scale, seconds)  # (T, n)
-        self.heading_ref = ref.track(scale, seconds)[:, 2]  # (T,) commanded heading [rad]
+        horizon = self.horizon(seconds, wait)
+        q = ref.trajectory(scale, horizon)  # (T', n)
+        self.q_cmd = q if offsets is None else q + offsets[: len(q)]
+        self.heading_ref = ref.track(scale, horizon)[:, 2]  # (T',) commanded heading [rad]
+        self.wait, self.max_wait = float(wait), round(MAX_WAIT_S / ref.dt)
+        self.down = ref.planned_load(scale, len(q))[0] if wait else None  # (T', 2)
+        self.clock = self.waited = 0  # the reference's tick; ticks waited at it
         names, stance = tuple(joint_names), ref.stance
         self.E = [channel_matrix(names, law.channels, stance) for law in self.laws]  # (P, n, m)
         self.start, self.n_loop = ref.starts.shape[1], ref.loops.shape[1]
@@ -182,21 +204,42 @@ class TickPolicy:
         self._f: list[np.ndarray] = []
         self._a: list[np.ndarray] = []
 
+    @staticmethod
+    def horizon(seconds: float, wait: float) -> float:
+        """How much of the reference [s] a walk of ``seconds`` may reach (twice as much
+        when its clock may wait)."""
+        return 2.0 * seconds if wait else seconds
+
     @property
     def q0(self) -> np.ndarray:
         """``(n,)`` the posture the walk starts from (:func:`imitwalk.sim.mujoco.run` uses it)."""
-        return self.q_ref[0]
+        return self.q_cmd[0]
 
     def phase_of(self, k: int) -> int:
         """The loop tick ψ of control tick ``k`` (the start-up shares the loop's timing)."""
         return (k - self.start) % self.n_loop
 
+    def _tick(self, k: int, obs) -> int:
+        """The reference's tick at control tick ``k`` (``k`` itself unless it waits)."""
+        if self.down is None:
+            return k
+        if k:
+            load = obs.foot_force.sum(axis=1)  # (2,) each sole's measured load [N]
+            share = load / max(float(load.sum()), 1e-9)
+            j = min(self.clock, len(self.down) - 2)
+            lifting = self.down[j] & ~self.down[j + 1]
+            if np.any(lifting & (share > self.wait)) and self.waited < self.max_wait:
+                self.waited += 1
+            else:
+                self.waited, self.clock = 0, self.clock + 1
+        return self.clock
+
     def __call__(self, k: int, obs) -> np.ndarray:
-        k = min(k, len(self.q_ref) - 1)
+        k = min(self._tick(k, obs), len(self.q_cmd) - 1)
         est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
         full = np.array([*est.gyro, est.roll, est.pitch, est.heading - self.heading_ref[k]])
         i = self.phase_of(k)
-        q = self.q_ref[k].copy()
+        q = self.q_cmd[k].copy()
         a = np.zeros(0)
         for j, law in enumerate(self.laws):
             x = full[self.pick[j]] - law.nominal[i % len(law.nominal)]

@@ -42,6 +42,11 @@ class TrialConfig:
     gyro rate pushes back against the fall.
 
     Attributes:
+        feedforward: candidate fractions of the servo feedforward added to the reference
+            (:mod:`imitwalk.retarget.feedforward`), tried first, with no feedback.
+        wait: candidate load shares above which the reference's clock waits before a
+            lift-off (0: it never waits; :class:`~imitwalk.balance.feedback.TickPolicy`),
+            tried next, with no feedback.
         pitch: candidate gains gyro_y → ankle_pitch [rad per rad/s].
         roll: candidate gains gyro_x → ankle_roll [rad per rad/s].
         heading: candidate gains heading → turn [rad of turn per step per rad of heading
@@ -56,6 +61,8 @@ class TrialConfig:
             proportion).
     """
 
+    feedforward: tuple[float, ...] = (0.0, 0.5, 1.0)
+    wait: tuple[float, ...] = (0.0, 0.3)
     pitch: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2)
     roll: tuple[float, ...] = (0.0, 0.05, 0.1)
     heading: tuple[float, ...] = (0.0, -0.25, -0.5)
@@ -67,6 +74,8 @@ class TrialConfig:
     heading_seconds: float = 30.0
 
     def __post_init__(self):
+        _range("trials.feedforward", self.feedforward, 0.0, 1.0)
+        _range("trials.wait", self.wait, 0.0, 0.95)
         _range("trials.pitch", self.pitch, -0.5, 0.5)
         _range("trials.roll", self.roll, -0.5, 0.5)
         _range("trials.heading", self.heading, -2.0, 2.0)

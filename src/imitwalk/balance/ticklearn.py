@@ -3,7 +3,11 @@
 Three stages, each checkpointed, so that an interrupted run resumes where it stopped
 and ends where an uninterrupted one would:
 
-1. **Trials** (:func:`_trials`): the feedback law gyro_y → ankle pitch, gyro_x → ankle
+1. **Trials** (:func:`_trials`): first, with no feedback, how the reference is played:
+   the fraction of the servo feedforward added to it
+   (:mod:`imitwalk.retarget.feedforward`), then the load share at which its clock waits
+   before a lift-off (:class:`~imitwalk.balance.feedback.TickPolicy`); then the
+   feedback law gyro_y → ankle pitch, gyro_x → ankle
    roll, heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
    chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
    many short walks of training robots: the baseline the learned law starts from.
@@ -50,7 +54,11 @@ from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.sim.perturb import TRAIN_SEED_BASE, TRIAL_SEED_BASE
 
-__all__ = ["TickProgress", "learn_tick"]
+__all__ = ["REFERENCE_SETTINGS", "TickProgress", "learn_tick"]
+
+#: How the reference is played, tried in this order before the gains, each named as in
+#: :class:`~imitwalk.balance.tickconfig.TrialConfig` and :class:`TickJob`.
+REFERENCE_SETTINGS = ("feedforward", "wait")
 
 
 @dataclass
@@ -59,7 +67,9 @@ class TickProgress:
 
     Attributes:
         stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
-        gains: the trial-picked gains so far, by setting name; trial: the next gain.
+        settings: how the reference is played, by name (:data:`REFERENCE_SETTINGS`),
+            as the trials picked them so far; gains: the trial-picked gains so far, by
+            setting name; trial: the next gain.
         scale_index, iteration: where the schedule is; passed: scales passed.
         trust: the fraction of the learned law kept (``None`` until decided).
         tried: every candidate's trial results so far, by key (run once each).
@@ -67,6 +77,7 @@ class TickProgress:
     """
 
     stage: str = "trials"
+    settings: dict = field(default_factory=dict)
     gains: dict = field(default_factory=dict)
     trial: int = 0
     scale_index: int = 0
@@ -94,8 +105,11 @@ class _Learner:
             for j in range(n)
         ]
 
-    def run(self, state: TickProgress, scale, laws, draws, seconds, explore=0.0, rng=0):
+    def run(self, state, scale, laws, draws, seconds, explore=0.0, rng=0, settings=None):
+        """Walk ``laws`` on ``draws``, the reference played with ``settings`` (default:
+        the ones kept)."""
         t0 = time.perf_counter()
+        settings = state.settings if settings is None else settings
         jobs = [
             TickJob(
                 self.ref_path,
@@ -108,6 +122,7 @@ class _Learner:
                 explore,
                 (self.cfg.seed, rng, j),
                 self.cfg.engine,
+                **settings,
             )
             for j, d in enumerate(draws)
         ]
@@ -117,16 +132,19 @@ class _Learner:
         return out
 
 
-def _trial(lr: _Learner, state: TickProgress, key: str, laws, heading: bool = False) -> Trial:
-    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), run
-    once per key (kept in the checkpoint, so that a resumed run neither repeats nor
-    re-counts them)."""
+def _trial(lr: _Learner, state, key: str, laws, heading=False, settings=None) -> Trial:
+    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
+    reference played with ``settings`` (default: the ones kept), run once per key (kept
+    in the checkpoint, so that a resumed run neither repeats nor re-counts them)."""
     t = lr.cfg.trials
     n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
+    settings = state.settings if settings is None else settings
+    key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
     key = f"{key}@{n}x{seconds:g}s"
     if key not in state.tried:
         top = lr.scales[-1]
-        res = lr.run(state, top, laws, lr.robots(n, TRIAL_SEED_BASE + 1, seconds), seconds)
+        draws = lr.robots(n, TRIAL_SEED_BASE + 1, seconds)
+        res = lr.run(state, top, laws, draws, seconds, settings=settings)
         state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
     return Trial([TickResult(**r) for r in state.tried[key]])
 
@@ -144,9 +162,30 @@ def _say_table(lr: _Learner, head: str, table) -> None:
     lr.say(f"{head} {' '.join(cells)}")
 
 
-def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
-    """Stage 1: one gain at a time, each from its candidates, at the top scale."""
+def _reference_settings(lr: _Learner, state: TickProgress, log: list) -> None:
+    """Stage 1's first choices: how the reference is played, one setting at a time, with
+    no feedback, at the top scale. Without a task-space plan (the paper's mapping) the
+    reference is played as it is."""
     cfg = lr.cfg
+    laws = [feedback_law(cfg, {})]
+    for name in REFERENCE_SETTINGS[len(state.settings) :]:
+        candidates = getattr(cfg.trials, name) if lr.ref.plan else (0.0,)
+        table = []
+        for value in candidates:
+            settings = {**state.settings, name: float(value)}
+            table.append((float(value), _trial(lr, state, _gains_key({}), laws, False, settings)))
+        state.settings[name] = kept = min(table, key=lambda row: row[1].rank(row[0]))[0]
+        rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
+        log.append({"stage": "trials", "gain": name, "kept": kept, "table": rows})
+        _say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
+        _checkpoint(lr, state, log)
+
+
+def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
+    """Stage 1: how the reference is played, then one gain at a time, each from its
+    candidates, at the top scale."""
+    cfg = lr.cfg
+    _reference_settings(lr, state, log)
     while state.trial < len(TRIAL_GAINS):
         name, channel, feature, steers = TRIAL_GAINS[state.trial]
         limit = cfg.trials.yaw_limit_deg if steers else None
@@ -295,6 +334,7 @@ def learn_tick(
         trial_falls_at_top=top_falls,
         feedback_gains=state.gains,
         trust=state.trust,
+        reference_settings=state.settings,
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary

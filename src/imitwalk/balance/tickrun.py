@@ -26,7 +26,10 @@ class TickJob:
         laws: the feedback laws (their outputs add up); seed: the training robot;
         options: its simulation; seconds: simulated time [s]; explore: exploration
         amplitude [rad] on the last law; rng: the exploration's seed; engine: the
-        physics engine; record: return the recorded episode.
+        physics engine; record: return the recorded episode; feedforward: the fraction
+        of the servo feedforward added to the reference (0: none); wait: the load share
+        above which the reference waits before a lift-off (0: never;
+        :class:`~imitwalk.balance.feedback.TickPolicy`).
     """
 
     ref_path: str
@@ -40,6 +43,8 @@ class TickJob:
     rng: tuple[int, ...] = (0,)
     engine: str = "mujoco"
     record: bool = True
+    feedforward: float = 0.0
+    wait: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -81,9 +86,17 @@ def run_tick_episode(job: TickJob) -> TickResult:
     from imitwalk.sim.mujoco import make_plant, run
 
     ref = _reference(job.ref_path)
+    offsets = None
+    if job.feedforward:
+        from imitwalk.retarget.feedforward import reference_offsets
+
+        horizon = TickPolicy.horizon(job.seconds, job.wait)
+        offsets = job.feedforward * reference_offsets(ref, job.robot, job.scale, horizon)
+    names = job.robot.joint_names
     policy = TickPolicy(
-        ref, job.scale, job.laws, job.robot.joint_names, job.seconds, job.explore, seed=job.rng
-    )
+        ref, job.scale, job.laws, names, job.seconds, job.explore, seed=job.rng,
+        offsets=offsets, wait=job.wait,
+    )  # fmt: skip
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
     ro = run(plant, policy, len(policy.q_ref))
     m = walk_metrics(
@@ -146,12 +159,14 @@ class Trial:
     def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
         """The order candidates are kept in (least first): the fewest falls; then, where
         the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
-        beyond that limit; then the smallest ``|value|``. A lower
+        beyond that limit; where every robot fell, the longest walked; then the smallest
+        ``|value|``. A lower
         Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
         the gain where robots start to fall (docs/RESULTS.md)."""
         s = self.summary()
         drift = 0.0 if yaw_limit_deg is None else max(0.0, s.abs_yaw_deg - yaw_limit_deg)
-        return (s.falls, drift, abs(value))
+        walked = -s.walked_s if s.falls == s.robots else 0.0
+        return (s.falls, drift, walked, abs(value))
 
     def summary(self) -> WalkSummary:
         """:func:`summarize` of its walks."""

@@ -46,7 +46,11 @@ class LoadedRun:
         path: its folder; learner: ``"tick"`` or ``"faithful"``; ref: its reference;
         scale: the scale it reached; engine: the engine it learned on; metrics: its
         ``metrics.json`` (a :class:`~imitwalk.runs.LearnSummary`); laws: the per-tick
-        run's feedback laws by controller name;
+        run's feedback laws by controller name; settings: how the per-tick run's
+        trials chose to play the reference (``feedforward``, ``wait``:
+        :attr:`~imitwalk.runs.LearnSummary.reference_settings`), for its ``learned`` and
+        ``feedback`` controllers (``fixed``, the hand-set baseline, and ``open_loop``
+        play the reference as it is);
         gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`).
     """
 
@@ -58,6 +62,13 @@ class LoadedRun:
     metrics: LearnSummary
     laws: dict | None = None
     gait: LearnedGait | None = None
+    settings: dict | None = None
+
+    def settings_of(self, controller: str) -> dict:
+        """How ``controller`` plays the reference: ``feedforward`` and ``wait`` (0: not)."""
+        mine = (self.settings or {}) if controller in ("learned", "feedback") else {}
+        return {"feedforward": float(mine.get("feedforward", 0.0)),
+                "wait": float(mine.get("wait", 0.0))}  # fmt: skip
 
     def controllers(self) -> tuple[str, ...]:
         """The controllers it can build, ``open_loop`` last."""
@@ -72,6 +83,8 @@ class LoadedRun:
             return controller
         mine = [law.to_arrays("") for law in self.laws[controller]]
         for other in self.controllers():
+            if self.settings_of(other) != self.settings_of(controller):
+                continue
             theirs = [law.to_arrays("") for law in self.laws.get(other, ())]
             if len(theirs) == len(mine) and all(
                 a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
@@ -95,7 +108,16 @@ class LoadedRun:
         if self.laws is not None:
             from imitwalk.balance.feedback import TickPolicy
 
-            return TickPolicy(self.ref, scale, self.laws[controller], robot.joint_names, seconds)
+            offsets, s = None, self.settings_of(controller)
+            if s["feedforward"]:
+                from imitwalk.retarget.feedforward import reference_offsets
+
+                horizon = TickPolicy.horizon(seconds, s["wait"])
+                offsets = s["feedforward"] * reference_offsets(self.ref, robot, scale, horizon)
+            laws, names = self.laws[controller], robot.joint_names
+            return TickPolicy(
+                self.ref, scale, laws, names, seconds, offsets=offsets, wait=s["wait"]
+            )
         assert self.gait is not None  # a faithful run's
         return self.gait.policy(scale)
 
@@ -111,7 +133,8 @@ def load_run(run_dir) -> LoadedRun:
 
         ref = Reference.load(rd.file("reference.npz"))
         scale = float(metrics.scale_reached)
-        return LoadedRun(str(rd.path), "tick", ref, scale, engine, metrics, laws=load_laws(rd.path))
+        laws, settings = load_laws(rd.path), metrics.reference_settings
+        return LoadedRun(str(rd.path), "tick", ref, scale, engine, metrics, laws, settings=settings)
     from imitwalk.paper.evaluate import load_gait
 
     lg = load_gait(rd.path)

@@ -149,6 +149,18 @@ class Reference:
             return np.array([stride, 0.0, 0.0, stride, 0.0])
         return (1.0 - w) * self.motion[i] + w * self.motion[j]
 
+    def planned_load(self, scale: float, T: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(T, 2)`` the feet the plan has down (left, right) and ``(T,)`` the left sole's
+        share of the load (the centre of mass between the soles; 1 or 0 in single support)
+        over ``T`` ticks from standing."""
+        plan = self.plan_at(scale)
+        rows = self.loop_index(np.arange(T))[0]
+        down = np.stack([plan["l_sole"][rows, 2], plan["r_sole"][rows, 2]], 1) <= 1e-4
+        yl, yr, yc = plan["l_sole"][rows, 1], plan["r_sole"][rows, 1], plan["com"][rows, 1]
+        share = np.clip((yc - yr) / np.maximum(yl - yr, 1e-6), 0.0, 1.0)
+        one = np.where(down[:, 1] & ~down[:, 0], 0.0, share)
+        return down, np.where(down[:, 0] & ~down[:, 1], 1.0, one)
+
     def loop_index(self, k):
         """Where tick ``k`` from standing (int or int array) falls in the stored start-up
         and loop: the stored tick ``i`` and how many whole cycles ``c`` the loop has been
