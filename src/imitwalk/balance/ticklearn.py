@@ -3,7 +3,7 @@
 Three stages, each checkpointed, so that an interrupted run resumes where it stopped
 and ends where an uninterrupted one would:
 
-1. **Trials** (:func:`_trials`): first, with no feedback, how the reference is played:
+1. **Trials** (:func:`trials`): first, with no feedback, how the reference is played:
    the fraction of the servo feedforward added to it
    (:mod:`imitwalk.retarget.feedforward`), then the load share at which its clock waits
    before a lift-off (:class:`~imitwalk.balance.feedback.TickPolicy`); then the
@@ -30,183 +30,33 @@ Training robots come from ``train_protocol`` with seeds no evaluation uses.
 
 from __future__ import annotations
 
-import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import replace
 
 from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.lqr import Costs, horizon_gains
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import PhaseModel, nominal_profile
-from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode, summarize
-from imitwalk.balance.tickstore import (
-    TRIAL_GAINS,
-    feedback_law,
-    load_learned,
-    save_learned,
-    stack_episodes,
-    unstack_episodes,
+from imitwalk.balance.tickrun import summarize
+from imitwalk.balance.tickstore import feedback_law, load_learned, save_learned, unstack_episodes
+from imitwalk.balance.ticktrials import (
+    Learner,
+    TickProgress,
+    checkpoint,
+    gains_key,
+    say_table,
+    trial,
+    trials,
 )
 from imitwalk.config import to_dict
-from imitwalk.judge.protocol import load_protocol
-from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
-from imitwalk.sim.perturb import TRAIN_SEED_BASE, TRIAL_SEED_BASE
+from imitwalk.sim.perturb import TRAIN_SEED_BASE
 
-__all__ = ["REFERENCE_SETTINGS", "TickProgress", "learn_tick"]
-
-#: How the reference is played, tried in this order before the gains, each named as in
-#: :class:`~imitwalk.balance.tickconfig.TrialConfig` and :class:`TickJob`.
-REFERENCE_SETTINGS = ("feedforward", "wait")
+__all__ = ["TickProgress", "learn_tick"]
 
 
-@dataclass
-class TickProgress:
-    """Where a run is (``checkpoint.json``); nothing else crosses the stages.
-
-    Attributes:
-        stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
-        settings: how the reference is played, by name (:data:`REFERENCE_SETTINGS`),
-            as the trials picked them so far; gains: the trial-picked gains so far, by
-            setting name; trial: the next gain.
-        scale_index, iteration: where the schedule is; passed: scales passed.
-        trust: the fraction of the learned law kept (``None`` until decided).
-        tried: every candidate's trial results so far, by key (run once each).
-        sim_seconds, wall_seconds: what learning has cost so far [s].
-    """
-
-    stage: str = "trials"
-    settings: dict = field(default_factory=dict)
-    gains: dict = field(default_factory=dict)
-    trial: int = 0
-    scale_index: int = 0
-    iteration: int = 0
-    passed: list = field(default_factory=list)
-    trust: float | None = None
-    tried: dict = field(default_factory=dict)
-    sim_seconds: float = 0.0
-    wall_seconds: float = 0.0
-
-
-class _Learner:
-    """The stages' shared context: the run folder, the robots and the budget."""
-
-    def __init__(self, ref: Reference, robot: Robot, cfg: TickLearnConfig, rd: RunDir, progress):
-        self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
-        self.say = progress or (lambda _line: None)
-        self.protocol = load_protocol(cfg.train_protocol)
-        self.scales = cfg.scales()
-        self.ref_path = str(rd.file("reference.npz"))
-
-    def robots(self, n: int, first: int, seconds: float):
-        return [
-            self.protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds)
-            for j in range(n)
-        ]
-
-    def run(self, state, scale, laws, draws, seconds, explore=0.0, rng=0, settings=None):
-        """Walk ``laws`` on ``draws``, the reference played with ``settings`` (default:
-        the ones kept)."""
-        t0 = time.perf_counter()
-        settings = state.settings if settings is None else settings
-        jobs = [
-            TickJob(
-                self.ref_path,
-                self.robot,
-                scale,
-                tuple(laws),
-                d.seed,
-                d.options,
-                seconds,
-                explore,
-                (self.cfg.seed, rng, j),
-                self.cfg.engine,
-                **settings,
-            )
-            for j, d in enumerate(draws)
-        ]
-        out = run_parallel(run_tick_episode, jobs, self.cfg.workers)
-        state.sim_seconds += sum(r.seconds for r in out)
-        state.wall_seconds += time.perf_counter() - t0
-        return out
-
-
-def _trial(lr: _Learner, state, key: str, laws, heading=False, settings=None) -> Trial:
-    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
-    reference played with ``settings`` (default: the ones kept), run once per key (kept
-    in the checkpoint, so that a resumed run neither repeats nor re-counts them)."""
-    t = lr.cfg.trials
-    n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
-    settings = state.settings if settings is None else settings
-    key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
-    key = f"{key}@{n}x{seconds:g}s"
-    if key not in state.tried:
-        top = lr.scales[-1]
-        draws = lr.robots(n, TRIAL_SEED_BASE + 1, seconds)
-        res = lr.run(state, top, laws, draws, seconds, settings=settings)
-        state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
-    return Trial([TickResult(**r) for r in state.tried[key]])
-
-
-def _gains_key(gains: dict, extra: str = "") -> str:
-    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS) + extra
-
-
-def _say_table(lr: _Learner, head: str, table) -> None:
-    """One progress line: per candidate, its falls and mean |yaw|."""
-    cells = []
-    for v, t in table:
-        s = t.summary()
-        cells.append(f"[{v:g}: {s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg]")
-    lr.say(f"{head} {' '.join(cells)}")
-
-
-def _reference_settings(lr: _Learner, state: TickProgress, log: list) -> None:
-    """Stage 1's first choices: how the reference is played, one setting at a time, with
-    no feedback, at the top scale. Without a task-space plan (the paper's mapping) the
-    reference is played as it is."""
-    cfg = lr.cfg
-    laws = [feedback_law(cfg, {})]
-    for name in REFERENCE_SETTINGS[len(state.settings) :]:
-        candidates = getattr(cfg.trials, name) if lr.ref.plan else (0.0,)
-        table = []
-        for value in candidates:
-            settings = {**state.settings, name: float(value)}
-            table.append((float(value), _trial(lr, state, _gains_key({}), laws, False, settings)))
-        state.settings[name] = kept = min(table, key=lambda row: row[1].rank(row[0]))[0]
-        rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
-        log.append({"stage": "trials", "gain": name, "kept": kept, "table": rows})
-        _say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
-        _checkpoint(lr, state, log)
-
-
-def _trials(lr: _Learner, state: TickProgress, log: list) -> None:
-    """Stage 1: how the reference is played, then one gain at a time, each from its
-    candidates, at the top scale."""
-    cfg = lr.cfg
-    _reference_settings(lr, state, log)
-    while state.trial < len(TRIAL_GAINS):
-        name, channel, feature, steers = TRIAL_GAINS[state.trial]
-        limit = cfg.trials.yaw_limit_deg if steers else None
-        table = []
-        for value in getattr(cfg.trials, name):
-            gains = {**state.gains, name: float(value)}
-            laws = [feedback_law(cfg, gains)]
-            table.append((float(value), _trial(lr, state, _gains_key(gains), laws, steers)))
-        best = min(table, key=lambda row: row[1].rank(row[0], limit))[0]
-        state.gains[name] = best
-        log.append(
-            {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
-             "kept": best, "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
-        )  # fmt: skip
-        _say_table(lr, f"trials: {feature} -> {channel} = {best:g}", table)
-        state.trial += 1
-        _checkpoint(lr, state, log)
-    state.stage = "schedule" if cfg.lqr.enabled else "done"
-
-
-def _learned_law(lr: _Learner, episodes: list[Episode]):
+def _learned_law(lr: Learner, episodes: list[Episode]):
     """Fit the model on ``episodes`` and turn it into the learned law (and the model);
     the states are the features less their mean at each phase in ``episodes``."""
     c = lr.cfg.lqr
@@ -218,7 +68,7 @@ def _learned_law(lr: _Learner, episodes: list[Episode]):
     return replace(shell, gains=horizon_gains(model, costs)), model
 
 
-def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
+def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
     """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
     cfg = lr.cfg
     base = feedback_law(cfg, state.gains)
@@ -261,13 +111,13 @@ def _schedule(lr: _Learner, state: TickProgress, log: list, data: list) -> Feedb
         else:
             state.iteration += 1
         save_learned(lr.rd, learned)
-        _checkpoint(lr, state, log, data)
+        checkpoint(lr, state, log, data)
     save_learned(lr.rd, learned)
     state.stage = "trust"
     return learned
 
 
-def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
+def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
     """Stage 3: how much of the learned law to keep, by the trials at the top scale (the
     law the schedule learned at the highest scale it passed)."""
     cfg = lr.cfg
@@ -278,20 +128,13 @@ def _trust(lr: _Learner, state: TickProgress, log: list, learned: FeedbackLaw | 
     table = []
     for frac in cfg.lqr.trust:
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
-        key = _gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
-        table.append((float(frac), _trial(lr, state, key, laws)))
+        key = gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
+        table.append((float(frac), trial(lr, state, key, laws)))
     best = min(table, key=lambda row: row[1].rank(row[0]))[0]
     state.trust, state.stage = best, "done"
     log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
                 "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table]})  # fmt: skip
-    _say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
-
-
-def _checkpoint(lr: _Learner, state: TickProgress, log: list, data: list | None = None) -> None:
-    if data is not None:
-        lr.rd.write_arrays("data.npz", stack_episodes(data))
-    lr.rd.write_log(log)
-    lr.rd.write_json("checkpoint.json", asdict(state))
+    say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
 
 
 def learn_tick(
@@ -308,17 +151,17 @@ def learn_tick(
     saved, log = rd.start(cfg_json, ref, resume)
     state = TickProgress(**saved) if saved else TickProgress()
     data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []
-    lr = _Learner(ref, robot, config, rd, progress)
+    lr = Learner(ref, robot, config, rd, progress)
     if state.stage == "trials":
-        _trials(lr, state, log)
-        _checkpoint(lr, state, log, data)
+        trials(lr, state, log)
+        checkpoint(lr, state, log, data)
     learned = load_learned(rd)
     if state.stage == "schedule":
         learned = _schedule(lr, state, log, data)
-        _checkpoint(lr, state, log, data)
+        checkpoint(lr, state, log, data)
     if state.stage == "trust":
         _trust(lr, state, log, learned)
-        _checkpoint(lr, state, log, data)
+        checkpoint(lr, state, log, data)
     kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
     row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
     top_falls = int(row["falls"])

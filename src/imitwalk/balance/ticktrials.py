@@ -1,0 +1,190 @@
+"""The per-tick learner's shared context and its first stage, the trials
+(:mod:`imitwalk.balance.ticklearn` runs the stages).
+
+Trials pick, one setting at a time and each from its candidates, at the top scale, on
+many short walks of training robots (:class:`~imitwalk.balance.tickrun.Trial`): first,
+with no feedback, how the reference is played (:data:`REFERENCE_SETTINGS`), then the
+feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field, replace
+
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode
+from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, stack_episodes
+from imitwalk.judge.protocol import load_protocol
+from imitwalk.parallel import run_parallel
+from imitwalk.retarget.reference import Reference
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+from imitwalk.sim.perturb import TRIAL_SEED_BASE
+
+__all__ = [
+    "REFERENCE_SETTINGS",
+    "Learner",
+    "TickProgress",
+    "checkpoint",
+    "gains_key",
+    "say_table",
+    "trial",
+    "trials",
+]
+
+#: How the reference is played, tried in this order before the gains, each named as in
+#: :class:`~imitwalk.balance.tickconfig.TrialConfig` and :class:`TickJob`.
+REFERENCE_SETTINGS = ("feedforward", "wait")
+
+
+@dataclass
+class TickProgress:
+    """Where a run is (``checkpoint.json``); nothing else crosses the stages.
+
+    Attributes:
+        stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
+        settings: how the reference is played, by name (:data:`REFERENCE_SETTINGS`),
+            as the trials picked them so far; gains: the trial-picked gains so far, by
+            setting name; trial: the next gain.
+        scale_index, iteration: where the schedule is; passed: scales passed.
+        trust: the fraction of the learned law kept (``None`` until decided).
+        tried: every candidate's trial results so far, by key (run once each).
+        sim_seconds, wall_seconds: what learning has cost so far [s].
+    """
+
+    stage: str = "trials"
+    settings: dict = field(default_factory=dict)
+    gains: dict = field(default_factory=dict)
+    trial: int = 0
+    scale_index: int = 0
+    iteration: int = 0
+    passed: list = field(default_factory=list)
+    trust: float | None = None
+    tried: dict = field(default_factory=dict)
+    sim_seconds: float = 0.0
+    wall_seconds: float = 0.0
+
+
+class Learner:
+    """The stages' shared context: the run folder, the robots and the budget."""
+
+    def __init__(self, ref: Reference, robot: Robot, cfg: TickLearnConfig, rd: RunDir, progress):
+        self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
+        self.say = progress or (lambda _line: None)
+        self.protocol = load_protocol(cfg.train_protocol)
+        self.scales = cfg.scales()
+        self.ref_path = str(rd.file("reference.npz"))
+
+    def robots(self, n: int, first: int, seconds: float):
+        return [
+            self.protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds)
+            for j in range(n)
+        ]
+
+    def run(self, state, scale, laws, draws, seconds, explore=0.0, rng=0, settings=None):
+        """Walk ``laws`` on ``draws``, the reference played with ``settings`` (default:
+        the ones kept)."""
+        t0 = time.perf_counter()
+        settings = state.settings if settings is None else settings
+        jobs = [
+            TickJob(
+                self.ref_path,
+                self.robot,
+                scale,
+                tuple(laws),
+                d.seed,
+                d.options,
+                seconds,
+                explore,
+                (self.cfg.seed, rng, j),
+                self.cfg.engine,
+                **settings,
+            )
+            for j, d in enumerate(draws)
+        ]
+        out = run_parallel(run_tick_episode, jobs, self.cfg.workers)
+        state.sim_seconds += sum(r.seconds for r in out)
+        state.wall_seconds += time.perf_counter() - t0
+        return out
+
+
+def trial(lr: Learner, state, key: str, laws, heading=False, settings=None) -> Trial:
+    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
+    reference played with ``settings`` (default: the ones kept), run once per key (kept
+    in the checkpoint, so that a resumed run neither repeats nor re-counts them)."""
+    t = lr.cfg.trials
+    n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
+    settings = state.settings if settings is None else settings
+    key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
+    key = f"{key}@{n}x{seconds:g}s"
+    if key not in state.tried:
+        top = lr.scales[-1]
+        draws = lr.robots(n, TRIAL_SEED_BASE + 1, seconds)
+        res = lr.run(state, top, laws, draws, seconds, settings=settings)
+        state.tried[key] = [asdict(replace(r, episode=None)) for r in res]
+    return Trial([TickResult(**r) for r in state.tried[key]])
+
+
+def gains_key(gains: dict, extra: str = "") -> str:
+    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS) + extra
+
+
+def say_table(lr: Learner, head: str, table) -> None:
+    """One progress line: per candidate, its falls and mean |yaw|."""
+    cells = []
+    for v, t in table:
+        s = t.summary()
+        cells.append(f"[{v:g}: {s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg]")
+    lr.say(f"{head} {' '.join(cells)}")
+
+
+def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
+    """Stage 1's first choices: how the reference is played, one setting at a time, with
+    no feedback, at the top scale. Without a task-space plan (the paper's mapping) the
+    reference is played as it is."""
+    cfg = lr.cfg
+    laws = [feedback_law(cfg, {})]
+    for name in REFERENCE_SETTINGS[len(state.settings) :]:
+        candidates = getattr(cfg.trials, name) if lr.ref.plan else (0.0,)
+        table = []
+        for value in candidates:
+            settings = {**state.settings, name: float(value)}
+            table.append((float(value), trial(lr, state, gains_key({}), laws, False, settings)))
+        state.settings[name] = kept = min(table, key=lambda row: row[1].rank(row[0]))[0]
+        rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
+        log.append({"stage": "trials", "gain": name, "kept": kept, "table": rows})
+        say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
+        checkpoint(lr, state, log)
+
+
+def trials(lr: Learner, state: TickProgress, log: list) -> None:
+    """Stage 1: how the reference is played, then one gain at a time, each from its
+    candidates, at the top scale."""
+    cfg = lr.cfg
+    _reference_settings(lr, state, log)
+    while state.trial < len(TRIAL_GAINS):
+        name, channel, feature, steers = TRIAL_GAINS[state.trial]
+        limit = cfg.trials.yaw_limit_deg if steers else None
+        table = []
+        for value in getattr(cfg.trials, name):
+            gains = {**state.gains, name: float(value)}
+            laws = [feedback_law(cfg, gains)]
+            table.append((float(value), trial(lr, state, gains_key(gains), laws, steers)))
+        best = min(table, key=lambda row: row[1].rank(row[0], limit))[0]
+        state.gains[name] = best
+        log.append(
+            {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
+             "kept": best, "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
+        )  # fmt: skip
+        say_table(lr, f"trials: {feature} -> {channel} = {best:g}", table)
+        state.trial += 1
+        checkpoint(lr, state, log)
+    state.stage = "schedule" if cfg.lqr.enabled else "done"
+
+
+def checkpoint(lr: Learner, state: TickProgress, log: list, data: list | None = None) -> None:
+    if data is not None:
+        lr.rd.write_arrays("data.npz", stack_episodes(data))
+    lr.rd.write_log(log)
+    lr.rd.write_json("checkpoint.json", asdict(state))
