@@ -1,22 +1,20 @@
-"""The servos' sag taken out of the reference (:mod:`imitwalk.retarget.feedforward`),
-walked at fixed fractions, with the phase hold (a lead, not in the product).
+"""The servos' sag taken out of the reference (:mod:`imitwalk.retarget.feedforward`) and
+the phase wait, at fixed settings side by side on validation robots.
 
-The product's learner picks the feedforward's fraction by trials
-(``trials.feedforward``); this bench walks chosen fractions side by side on validation
-robots, and adds what the product lacks: the phase hold.
-
-``--fractions`` scale the offset (0: the reference as it is); ``--hold`` adds the phase
-hold of ``bench/phase_hold.py``. The walk is the run's controller, or open loop on a
-reference plus the learner's law with the gains of ``--gains pitch=G,roll=G,heading=G``
-(a missing one is 0), on training robots
-(variant ``train``) or validation robots of hard's variants, eval's and bullet's (on
-Bullet). Prints
-one JSON line per (variant, fraction): falls, their times, the mean distance [m] (ground
-truth, for the figure only) and the largest offset [rad]. With ``--sway``, instead, how
-the nominal robot's centre of mass follows the plan's sway in the first cycle.
+The product's learner picks both by trials (``trials.feedforward``, ``trials.wait``);
+this bench walks chosen ones: ``--fractions`` scale the offset (0: the reference as it
+is), ``--wait`` is the load share at which the reference's clock waits before a lift-off
+(:class:`~imitwalk.balance.feedback.TickPolicy`; 0: never). The walk is the run's
+controller, or open loop on a reference plus the learner's law with the gains of
+``--gains pitch=G,roll=G,heading=G`` (a missing one is 0), on training robots (variant
+``train``) or validation robots of hard's variants, eval's and bullet's (on Bullet).
+Prints one JSON line per (variant, fraction): falls, their times, the mean distance [m]
+(ground truth, for the figure only) and the largest offset [rad]. With ``--sway``,
+instead, how the nominal robot's centre of mass follows the plan's sway in the first
+cycle.
 
 Usage: ``python bench/feedforward.py REF.npz --robot g1.json --scale 0.3 --robots 4
---seconds 10 --variants train --fractions 0,0.5,1 [--gains pitch=0.05]``,
+--seconds 10 --variants train --fractions 0,0.5,1 [--gains pitch=0.05] [--wait 0.3]``,
 or ``python bench/feedforward.py RUN --variants friction,nokicks,eval``, or ``... --sway``.
 """
 
@@ -39,43 +37,12 @@ from imitwalk.robots import load_robot
 from imitwalk.sim.perturb import perturbed, train_seeds
 
 
-class FeedforwardPolicy:
-    """A run's :class:`TickPolicy` with ``offsets`` ``(T, n)`` [rad] added to its targets
-    (``T`` the ticks of ``2 × seconds``) and the optional phase hold."""
-
-    def __init__(self, ref, scale, laws, robot, seconds, offsets, hold=(1.0, 0.0)):
-        names = robot.joint_names
-        self.inner = TickPolicy(ref, scale, laws, names, 2 * seconds, offsets=offsets)
-        self.down = ref.planned_load(scale, len(self.inner.q_ref))[0]
-        self.hold, self.max_hold = hold[0], round(hold[1] / ref.dt)
-        self.i = self.held = 0
-
-    @property
-    def q0(self) -> np.ndarray:
-        return self.inner.q0
-
-    def __call__(self, k: int, obs) -> np.ndarray:
-        """The phase hold of ``bench/phase_hold.py``: before a planned lift-off the
-        reference waits while the lifting sole carries more than ``hold[0]`` of the load
-        (at most ``hold[1]`` s)."""
-        if k:
-            load = obs.foot_force.sum(axis=1)
-            share = load / max(float(load.sum()), 1e-9)
-            j = min(self.i, len(self.down) - 2)
-            lifting = self.down[j] & ~self.down[j + 1]
-            if np.any(lifting & (share > self.hold)) and self.held < self.max_hold:
-                self.held += 1
-            else:
-                self.held, self.i = 0, self.i + 1
-        return self.inner(self.i, obs)
-
-
 def _walk(job) -> tuple[bool, float | None, float, float]:
-    path, robot_name, scale, laws, options, seconds, offsets, hold, engine = job
+    path, robot_name, scale, laws, options, seconds, offsets, wait, engine = job
     from imitwalk.sim.mujoco import make_plant, run
 
     ref, robot = Reference.load(path), load_robot(robot_name)
-    policy = FeedforwardPolicy(ref, scale, laws, robot, seconds, offsets, hold)
+    policy = TickPolicy(ref, scale, laws, robot.joint_names, seconds, offsets=offsets, wait=wait)
     plant = make_plant(robot, ref.sim_options(options), engine)
     ro = run(plant, policy, round(seconds / ref.dt))
     distance = float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]) if len(ro.t) else 0.0
@@ -90,7 +57,7 @@ def sway_follow(ref: Reference, robot, scale: float, offsets: np.ndarray) -> dic
 
     n = ref.loops.shape[1]
     plan = ref.plan_at(scale)["com"][:n, 1]
-    policy = FeedforwardPolicy(ref, scale, (), robot, n * ref.dt, offsets[: 2 * n])
+    policy = TickPolicy(ref, scale, (), robot.joint_names, n * ref.dt, offsets=offsets)
     plant = MujocoPlant(robot, perturbed(train_seeds(1)[0], ref.sim_options()))
     q_ref = ref.trajectory(scale, 2 * n * ref.dt)
     knees = [robot.joint_names.index(j) for j in ("l_knee", "r_knee")]
@@ -121,10 +88,9 @@ def main() -> None:
     ap.add_argument("--fractions", default="0,1")
     ap.add_argument("--gains", default=None, help="with a reference: pitch=G,roll=G,heading=G")
     ap.add_argument("--sway", action="store_true", help="only how the body follows its sway")
-    ap.add_argument("--hold", default="1,0", help="phase hold threshold,max seconds (1,0: none)")
+    ap.add_argument("--wait", type=float, default=0.0, help="the phase wait's load share")
     args = ap.parse_args()
     robot = load_robot(args.robot)
-    hold = tuple(float(x) for x in args.hold.split(","))
     if args.source.endswith(".npz"):
         path, ref, scale = args.source, Reference.load(args.source), args.scale
         gains = dict(x.split("=") for x in args.gains.split(",")) if args.gains else None
@@ -145,12 +111,13 @@ def main() -> None:
         "bullet": load_protocol("bullet"),
     }
     if args.sway:
-        offsets = reference_offsets(ref, robot, scale, 2 * ref.loops.shape[1] * ref.dt)
+        offsets = reference_offsets(ref, robot, scale, ref.loops.shape[1] * ref.dt)
         for text in args.fractions.split(","):
             out = sway_follow(ref, robot, scale, float(text) * offsets)
             print(json.dumps({"fraction": float(text), **out}))
         return
-    offsets = reference_offsets(ref, robot, scale, 2 * args.seconds)  # at fraction 1
+    horizon = TickPolicy.horizon(args.seconds, args.wait)
+    offsets = reference_offsets(ref, robot, scale, horizon)  # at fraction 1
     summary = {}
     for name in args.variants.split(","):
         engine = "mujoco" if name == "train" else protos[name].engine
@@ -162,7 +129,7 @@ def main() -> None:
                        for s in range(args.robots)]  # fmt: skip
         for text in args.fractions.split(","):
             off = float(text) * offsets
-            jobs = [(path, args.robot, scale, laws, o, args.seconds, off, hold, engine)
+            jobs = [(path, args.robot, scale, laws, o, args.seconds, off, args.wait, engine)
                     for o in options]  # fmt: skip
             res = run_parallel(_walk, jobs)
             times = sorted(round(t, 2) for f, t, *_ in res if f)
