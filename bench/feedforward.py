@@ -32,7 +32,7 @@ from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.replay import OPEN_LOOP, load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget import Reference
-from imitwalk.retarget.feedforward import reference_offsets
+from imitwalk.retarget.feedforward import reference_offsets, walk_offsets
 from imitwalk.robots import load_robot
 from imitwalk.sim.perturb import perturbed, train_seeds
 
@@ -116,8 +116,7 @@ def main() -> None:
             out = sway_follow(ref, robot, scale, float(text) * offsets)
             print(json.dumps({"fraction": float(text), **out}))
         return
-    horizon = TickPolicy.horizon(args.seconds, args.wait)
-    offsets = reference_offsets(ref, robot, scale, horizon)  # at fraction 1
+    offsets = walk_offsets(ref, robot, scale, args.seconds, 1.0)
     summary = {}
     for name in args.variants.split(","):
         engine = "mujoco" if name == "train" else protos[name].engine

@@ -39,12 +39,12 @@ def test_a_per_tick_run_builds_learned_feedback_fixed_and_open_loop(tick_run, ro
 def test_the_learned_controllers_add_the_kept_feedforward(tick_run, robot):
     from dataclasses import replace
 
-    from imitwalk.retarget.feedforward import reference_offsets
+    from imitwalk.retarget.feedforward import walk_offsets
 
     lr = load_run(tick_run)
     assert lr.settings == lr.metrics.reference_settings
     lr = replace(lr, settings={"feedforward": 0.5, "wait": 0.0})
-    off = reference_offsets(lr.ref, robot, lr.scale, 4.0)
+    off = walk_offsets(lr.ref, robot, lr.scale, 4.0, 1.0)[: len(lr.ref.trajectory(lr.scale, 4.0))]
     for name in ("learned", "feedback", "fixed"):
         policy = lr.policy(name, robot, seconds=4.0)
         want = 0.0 if name == "fixed" else 0.5  # the hand-set baseline plays it as it is

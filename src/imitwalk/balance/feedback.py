@@ -159,9 +159,10 @@ class TickPolicy:
         joint_names: the robot's roles (for the channel maps); seconds: how long the
             walk runs [s]; explore: exploration amplitude [rad] on every channel of the
             last law (0: none); hold: ticks each exploration draw is held; seed: its
-            random stream; offsets: ``(T', n)`` [rad] added to every target, ``T'`` the
-            ticks of :meth:`horizon` (the servo feedforward of
-            :func:`imitwalk.retarget.feedforward.reference_offsets`; ``None``: none);
+            random stream; offsets: ``(T', n)`` [rad] added to every target, ``T'`` at
+            least the ticks of twice ``seconds`` if it waits, else of ``seconds`` (the
+            servo feedforward, :func:`imitwalk.retarget.feedforward.walk_offsets`;
+            ``None``: none);
             wait: the load share [0, 1) above which the reference waits before a lift-off
             (0: it never waits). ``q_ref`` ``(T, n)`` stays the reference for ``seconds``
             (what a walk is measured against).
@@ -182,7 +183,7 @@ class TickPolicy:
     ):
         self.laws = tuple(laws)
         self.q_ref = ref.trajectory(scale, seconds)  # (T, n)
-        horizon = self.horizon(seconds, wait)
+        horizon = 2.0 * seconds if wait else seconds  # how far a waiting clock may reach
         q = ref.trajectory(scale, horizon)  # (T', n)
         self.q_cmd = q if offsets is None else q + offsets[: len(q)]
         self.heading_ref = ref.track(scale, horizon)[:, 2]  # (T',) commanded heading [rad]
@@ -203,12 +204,6 @@ class TickPolicy:
         self._phase: list[int] = []
         self._f: list[np.ndarray] = []
         self._a: list[np.ndarray] = []
-
-    @staticmethod
-    def horizon(seconds: float, wait: float) -> float:
-        """How much of the reference [s] a walk of ``seconds`` may reach (twice as much
-        when its clock may wait)."""
-        return 2.0 * seconds if wait else seconds
 
     @property
     def q0(self) -> np.ndarray:

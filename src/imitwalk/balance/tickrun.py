@@ -86,12 +86,9 @@ def run_tick_episode(job: TickJob) -> TickResult:
     from imitwalk.sim.mujoco import make_plant, run
 
     ref = _reference(job.ref_path)
-    offsets = None
-    if job.feedforward:
-        from imitwalk.retarget.feedforward import reference_offsets
+    from imitwalk.retarget.feedforward import walk_offsets
 
-        horizon = TickPolicy.horizon(job.seconds, job.wait)
-        offsets = job.feedforward * reference_offsets(ref, job.robot, job.scale, horizon)
+    offsets = walk_offsets(ref, job.robot, job.scale, job.seconds, job.feedforward)
     names = job.robot.joint_names
     policy = TickPolicy(
         ref, job.scale, job.laws, names, job.seconds, job.explore, seed=job.rng,

@@ -107,13 +107,10 @@ class LoadedRun:
             raise unknown_name("controller", controller, self.controllers(), ConfigError)
         if self.laws is not None:
             from imitwalk.balance.feedback import TickPolicy
+            from imitwalk.retarget.feedforward import walk_offsets
 
-            offsets, s = None, self.settings_of(controller)
-            if s["feedforward"]:
-                from imitwalk.retarget.feedforward import reference_offsets
-
-                horizon = TickPolicy.horizon(seconds, s["wait"])
-                offsets = s["feedforward"] * reference_offsets(self.ref, robot, scale, horizon)
+            s = self.settings_of(controller)
+            offsets = walk_offsets(self.ref, robot, scale, seconds, s["feedforward"])
             laws, names = self.laws[controller], robot.joint_names
             return TickPolicy(
                 self.ref, scale, laws, names, seconds, offsets=offsets, wait=s["wait"]

@@ -29,7 +29,7 @@ from scipy.ndimage import gaussian_filter1d
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
 
-__all__ = ["CLIP", "SMOOTH", "reference_offsets", "servo_offsets"]
+__all__ = ["CLIP", "SMOOTH", "reference_offsets", "servo_offsets", "walk_offsets"]
 
 #: Accelerations are smoothed over this many ticks (σ); offsets are clipped to ±CLIP [rad].
 SMOOTH, CLIP = 2.0, 0.2
@@ -123,3 +123,11 @@ def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np
         down, share = ref.planned_load(scale, len(q))
         _CACHE[key] = servo_offsets(robot, q, down, share, ref.dt)
     return _CACHE[key]
+
+
+def walk_offsets(ref: Reference, robot, scale: float, seconds: float, fraction: float):
+    """``fraction`` × :func:`reference_offsets` for a walk of ``seconds`` whose clock may
+    wait (``(T', n)``, ``T'`` the ticks of twice as long), or ``None`` at a fraction of 0."""
+    if not fraction:
+        return None
+    return fraction * reference_offsets(ref, robot, scale, 2.0 * seconds)
