@@ -111,6 +111,7 @@ def test_report_is_self_contained(report):
         "Fig. 8",
         "straight ahead on level ground",
         "trial-picked gains",
+        "reference played with feedforward",
     ):
         assert needed in text, needed
     mp4 = path.with_name("before_after.mp4").read_bytes()

@@ -74,8 +74,8 @@ def outcome(ro: Rollout) -> str:
 
 
 def summary_phrase(metrics: LearnSummary) -> str:
-    """What a run kept, in a phrase: a per-tick run's trial-picked gains and the fraction
-    of its model-based law; a faithful run's iterations."""
+    """What a run kept, in a phrase: a per-tick run's trial-picked reference settings,
+    gains and the fraction of its model-based law; a faithful run's iterations."""
     gains = metrics.feedback_gains
     if gains is None:
         return f"{metrics.iterations} iterations of the paper's learner"
@@ -84,7 +84,10 @@ def summary_phrase(metrics: LearnSummary) -> str:
     kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
     trust = metrics.trust
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"
-    return f"trial-picked gains {kept}{learned}"
+    played = metrics.reference_settings or {}
+    ref = ", ".join(f"{k} {v:g}" for k, v in played.items())
+    ref = f"reference played with {ref}; " if ref else ""
+    return f"{ref}trial-picked gains {kept}{learned}"
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
