@@ -8,7 +8,7 @@ import pytest
 
 from imitwalk.balance.feedback import TickPolicy
 from imitwalk.errors import ConfigError
-from imitwalk.retarget.feedforward import CLIP, reference_offsets
+from imitwalk.retarget.feedforward import CLIP, reference_offsets, servo_offsets
 from imitwalk.sim.mujoco import MujocoPlant
 
 LEGS = ("hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
@@ -29,6 +29,18 @@ def test_offsets_are_bounded_and_follow_the_reference(tiny_reference, robot):
     knee = robot.joint_names.index("l_knee")
     sign = np.sign(np.median(ref.trajectory(0.3, 3.0)[single, knee]))
     assert np.median(sign * off[single, knee]) < 0
+
+
+def test_a_long_walk_repeats_the_steady_loop_as_a_whole_computation_gives_it(tiny_reference, robot):
+    ref, _ = tiny_reference
+    q = ref.trajectory(0.3, 8.0)  # several loops past the start-up
+    down, share = ref.planned_load(0.3, len(q))
+    whole = servo_offsets(robot, q, down, share, ref.dt)
+    off = reference_offsets(ref, robot, 0.3, 8.0)
+    # equal but for the whole computation's last ticks (its finite differences' edge)
+    np.testing.assert_allclose(off[:-10], whole[:-10], atol=1e-9)
+    short = reference_offsets(ref, robot, 0.3, 3.0)
+    np.testing.assert_array_equal(off[: len(short)], short)  # a walk's length changes nothing
 
 
 def _leg_error(ref, robot, offsets, ticks: int) -> float:

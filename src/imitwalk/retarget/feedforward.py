@@ -34,7 +34,7 @@ __all__ = ["CLIP", "SMOOTH", "reference_offsets", "servo_offsets", "walk_offsets
 #: Accelerations are smoothed over this many ticks (σ); offsets are clipped to ±CLIP [rad].
 SMOOTH, CLIP = 2.0, 0.2
 
-_CACHE: dict[tuple, np.ndarray] = {}
+_CACHE: dict[tuple, tuple[np.ndarray, np.ndarray, dict]] = {}
 
 
 def _servo_gains(m, jid: list[int]) -> tuple[np.ndarray, np.ndarray]:
@@ -101,10 +101,29 @@ def servo_offsets(
     return np.clip(out, -CLIP, CLIP)
 
 
+def _cycles(ref: Reference, robot, scale: float) -> tuple[np.ndarray, np.ndarray, dict]:
+    """:func:`servo_offsets` of the start-up and first loop ``(M + N, n)``, and of one
+    loop in the steady walk ``(N, n)`` (the second of three, clear of both ends' finite
+    differences): every later cycle repeats it. Computed once per reference, scale and
+    robot in a process (the last few kept), with the walks built from them by length."""
+    m, n = ref.starts.shape[1], ref.loops.shape[1]
+    q = ref.trajectory(scale, (m + 3 * n) * ref.dt)
+    key = (hashlib.sha1(q.tobytes()).hexdigest(), str(robot.mjcf), robot.name,
+           robot.kp.tobytes())  # fmt: skip
+    if key not in _CACHE:
+        if len(_CACHE) >= 4:
+            _CACHE.pop(next(iter(_CACHE)))
+        down, share = ref.planned_load(scale, len(q))
+        out = servo_offsets(robot, q, down, share, ref.dt)
+        _CACHE[key] = (out[: m + n], out[m + n : m + 2 * n], {})
+    return _CACHE[key]
+
+
 def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np.ndarray:
     """``(T, n)`` :func:`servo_offsets` of ``ref`` at ``scale`` for ``seconds`` (``T`` the
-    ticks of :meth:`Reference.trajectory`), on ``robot``'s nominal model; the last few
-    are kept, so that the many walks of one reference compute them once per process.
+    ticks of :meth:`Reference.trajectory`), on ``robot``'s nominal model: the start-up and
+    first loop as computed, then the steady loop repeated (:meth:`Reference.loop_index`),
+    so that a walk of any length costs one computation of four cycles.
 
     Raises:
         ConfigError: the reference has no task-space plan (the paper's mapping).
@@ -114,15 +133,13 @@ def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np
             "the feedforward needs the reference's task-space plan; the paper's mapping "
             "has none: use trials.feedforward=0 or the walkable mapping"
         )
-    q = ref.trajectory(scale, seconds)
-    key = (hashlib.sha1(q.tobytes()).hexdigest(), str(robot.mjcf), robot.name,
-           robot.kp.tobytes())  # fmt: skip
-    if key not in _CACHE:
-        if len(_CACHE) >= 4:
-            _CACHE.pop(next(iter(_CACHE)))
-        down, share = ref.planned_load(scale, len(q))
-        _CACHE[key] = servo_offsets(robot, q, down, share, ref.dt)
-    return _CACHE[key]
+    first, loop, walks = _cycles(ref, robot, scale)
+    T = len(ref.trajectory(scale, seconds))
+    if T not in walks:
+        i, c = ref.loop_index(np.arange(T))
+        m = ref.starts.shape[1]
+        walks[T] = np.where((c == 0)[:, None], first[i], loop[(i - m) % len(loop)])
+    return walks[T]
 
 
 def walk_offsets(ref: Reference, robot, scale: float, seconds: float, fraction: float):
