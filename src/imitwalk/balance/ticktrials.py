@@ -126,8 +126,9 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None) -> T
     return Trial([TickResult(**r) for r in state.tried[key]])
 
 
-def gains_key(gains: dict, extra: str = "") -> str:
-    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS) + extra
+def gains_key(gains: dict) -> str:
+    """The trials' key of a law with ``gains`` by setting name (a missing one is 0)."""
+    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS)
 
 
 def say_table(lr: Learner, head: str, table) -> None:
