@@ -41,6 +41,20 @@ def test_a_map_with_stop_returns_the_shortest_prefix_it_accepts_and_skips_the_re
     assert run_parallel(_square, [0, 1, 2], workers=2, stop=stop) == [0, 1, 4]  # never held
 
 
+def test_a_stopped_map_hands_back_every_job_that_ran_beyond_its_prefix(tmp_path):
+    """What ran and was not returned is paid for: ``spent`` gets exactly those jobs."""
+    for workers in (1, 2):
+        folder = tmp_path / str(workers)
+        folder.mkdir()
+        spent: list = []
+        out = run_parallel(
+            _mark, [(folder, x) for x in range(40)], workers, lambda s: len(s) == 4, spent
+        )
+        ran = sorted(int(p.stem) for p in folder.iterdir())
+        assert out == [0, 1, 4, 9]
+        assert [x * x for x in ran[4:]] == spent  # in job order
+
+
 def test_unknown_executor_lists_the_valid_ones(monkeypatch):
     monkeypatch.setenv("IMITWALK_EXECUTOR", "dask")
     with pytest.raises(ConfigError, match="valid: process, ray"):

@@ -26,7 +26,11 @@ EXECUTORS = ("process", "ray")
 
 
 def run_parallel(
-    fn: Callable, jobs: list, workers: int | None = None, stop: Callable | None = None
+    fn: Callable,
+    jobs: list,
+    workers: int | None = None,
+    stop: Callable | None = None,
+    spent: list | None = None,
 ) -> list:
     """``[fn(j) for j in jobs]`` on the configured executor.
 
@@ -35,12 +39,14 @@ def run_parallel(
     if given, is asked after each result in job order; once it says True, the rest of
     the jobs are cancelled (those already running finish, unused) and the results so far
     are returned: the shortest prefix of ``[fn(j) for j in jobs]`` that ``stop`` accepts.
+    ``spent``, if given, receives the results of the jobs beyond that prefix that ran to
+    their end all the same (unused, but paid for), in job order.
     """
     executor = os.environ.get("IMITWALK_EXECUTOR", "process")
     if executor not in EXECUTORS:
         raise unknown_name("IMITWALK_EXECUTOR", executor, EXECUTORS, ConfigError)
     if executor == "ray" and len(jobs) > 1 and workers != 1:
-        return _ray_map(fn, jobs, stop)
+        return _ray_map(fn, jobs, stop, spent)
     default = int(os.environ.get("IMITWALK_WORKERS", 0)) or os.cpu_count() or 1
     workers = min(len(jobs), workers or default)
     if workers <= 1:
@@ -50,8 +56,9 @@ def run_parallel(
             return list(pool.map(fn, jobs))
         futures = [pool.submit(fn, j) for j in jobs]
         out = _until(futures, lambda f: f.result(), stop)
-        for f in futures[len(out) :]:
-            f.cancel()
+        ran = [f for f in futures[len(out) :] if not f.cancel()]
+        if spent is not None:
+            spent.extend(f.result() for f in ran)
         return out
 
 
@@ -65,7 +72,7 @@ def _until(pending, get: Callable, stop: Callable | None) -> list:
     return out
 
 
-def _ray_map(fn: Callable, jobs: list, stop: Callable | None = None) -> list:
+def _ray_map(fn: Callable, jobs: list, stop: Callable | None, spent: list | None) -> list:
     try:
         import ray
     except ImportError:
@@ -84,4 +91,10 @@ def _ray_map(fn: Callable, jobs: list, stop: Callable | None = None) -> list:
     out = _until(refs, ray.get, stop)
     for r in refs[len(out) :]:
         ray.cancel(r)
+    if spent is not None:
+        for r in refs[len(out) :]:
+            try:
+                spent.append(ray.get(r))
+            except ray.exceptions.TaskCancelledError:
+                pass  # cancelled before it ended: nothing was paid for it
     return out

@@ -36,11 +36,12 @@ from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.lqr import Costs, horizon_gains
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import PhaseModel, nominal_profile
-from imitwalk.balance.tickrun import summarize
+from imitwalk.balance.tickrun import Trial, summarize
 from imitwalk.balance.tickstore import feedback_law, load_learned, save_learned, unstack_episodes
 from imitwalk.balance.ticktrials import (
     Learner,
     TickProgress,
+    best,
     checkpoint,
     gains_key,
     say_table,
@@ -125,16 +126,17 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
         state.trust, state.stage = 0.0, "done"
         return
     base = feedback_law(cfg, state.gains)
-    table = []
+    table: list[tuple[float, Trial]] = []
     for frac in cfg.lqr.trust:
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
         key = gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
-        table.append((float(frac), trial(lr, state, key, laws)))
-    best = min(table, key=lambda row: row[1].rank(row[0]))[0]
-    state.trust, state.stage = best, "done"
-    log.append({"stage": "trust", "scale": lr.scales[-1], "kept": best,
+        top = best(table)
+        table.append((float(frac), trial(lr, state, key, laws, beat=top and top[1])))
+    kept = best(table)[0]
+    state.trust, state.stage = kept, "done"
+    log.append({"stage": "trust", "scale": lr.scales[-1], "kept": kept,
                 "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table]})  # fmt: skip
-    say_table(lr, f"trust at {lr.scales[-1]:g}: kept {best:g}", table)
+    say_table(lr, f"trust at {lr.scales[-1]:g}: kept {kept:g}", table)
 
 
 def learn_tick(
