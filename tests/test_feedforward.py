@@ -89,9 +89,9 @@ def test_the_clock_waits_while_the_lifting_sole_is_loaded(tiny_reference, robot)
     loaded = _obs(*((40.0, 10.0) if side == 0 else (10.0, 40.0)))
     for k in range(lift + 1):  # up to the lift-off, with the lifting sole loaded
         np.testing.assert_array_equal(policy(k, loaded), policy.q_cmd[k])
-    for k in range(lift + 1, lift + 1 + policy.max_wait):  # it waits, at most MAX_WAIT_S
+    for k in range(lift + 1, lift + 1 + policy.clock.max_wait):  # it waits, at most MAX_WAIT_S
         np.testing.assert_array_equal(policy(k, loaded), policy.q_cmd[lift])
-    k = lift + 1 + policy.max_wait
+    k = lift + 1 + policy.clock.max_wait
     np.testing.assert_array_equal(policy(k, loaded), policy.q_cmd[lift + 1])
     unloaded = _obs(*((0.0, 50.0) if side == 0 else (50.0, 0.0)))
     np.testing.assert_array_equal(policy(k + 1, unloaded), policy.q_cmd[lift + 2])

@@ -43,6 +43,7 @@ NUMPY_ONLY = (
     "retarget.template",
     "runs",
     "sim",
+    "sim.clock",
     "sim.metrics",
     "sim.perturb",
     "sim.servo",

@@ -19,7 +19,8 @@ Two optional parts are the reference's, not feedback: a servo feedforward added 
 ``q_ref`` (``offsets``, :mod:`imitwalk.retarget.feedforward`), and the phase wait (``wait``,
 eq. 9's phase advance made by the sole forces): before a planned lift-off the reference's
 clock waits while the sole about to lift still carries more than ``wait`` of the
-measured load, at most :data:`MAX_WAIT_S` per lift-off.
+measured load, at most :data:`~imitwalk.sim.clock.MAX_WAIT_S` per lift-off
+(:class:`~imitwalk.sim.clock.LoadClock`).
 """
 
 from __future__ import annotations
@@ -32,11 +33,9 @@ from imitwalk.balance.channels import FEATURES, channel_matrix, check_names
 from imitwalk.balance.estimator import StateEstimator
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
+from imitwalk.sim.clock import LoadClock
 
-__all__ = ["MAX_WAIT_S", "Episode", "FeedbackLaw", "TickPolicy"]
-
-#: The longest the reference's clock waits at one lift-off [s].
-MAX_WAIT_S = 0.5
+__all__ = ["Episode", "FeedbackLaw", "TickPolicy"]
 
 
 @dataclass(frozen=True)
@@ -187,9 +186,8 @@ class TickPolicy:
         q = ref.trajectory(scale, horizon)  # (T', n)
         self.q_cmd = q if offsets is None else q + offsets[: len(q)]
         self.heading_ref = ref.track(scale, horizon)[:, 2]  # (T',) commanded heading [rad]
-        self.wait, self.max_wait = float(wait), round(MAX_WAIT_S / ref.dt)
-        self.down = ref.planned_load(scale, len(q))[0] if wait else None  # (T', 2)
-        self.clock = self.waited = 0  # the reference's tick; ticks waited at it
+        down = ref.planned_load(scale, len(q))[0] if wait else None  # (T', 2)
+        self.clock = None if down is None else LoadClock(down, wait, ref.dt)
         names, stance = tuple(joint_names), ref.stance
         self.E = [channel_matrix(names, law.channels, stance) for law in self.laws]  # (P, n, m)
         self.start, self.n_loop = ref.starts.shape[1], ref.loops.shape[1]
@@ -216,18 +214,7 @@ class TickPolicy:
 
     def _tick(self, k: int, obs) -> int:
         """The reference's tick at control tick ``k`` (``k`` itself unless it waits)."""
-        if self.down is None:
-            return k
-        if k:
-            load = obs.foot_force.sum(axis=1)  # (2,) each sole's measured load [N]
-            share = load / max(float(load.sum()), 1e-9)
-            j = min(self.clock, len(self.down) - 2)
-            lifting = self.down[j] & ~self.down[j + 1]
-            if np.any(lifting & (share > self.wait)) and self.waited < self.max_wait:
-                self.waited += 1
-            else:
-                self.waited, self.clock = 0, self.clock + 1
-        return self.clock
+        return k if self.clock is None else self.clock.tick(k, obs.foot_force)
 
     def __call__(self, k: int, obs) -> np.ndarray:
         k = min(self._tick(k, obs), len(self.q_cmd) - 1)
