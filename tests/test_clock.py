@@ -9,7 +9,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from imitwalk.sim.clock import MAX_WAIT_S, LoadClock
+from imitwalk.balance.clock import MAX_WAIT_S, LoadClock
 
 DT = 0.01
 

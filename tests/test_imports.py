@@ -10,6 +10,7 @@ import sys
 NUMPY_ONLY = (
     "balance",
     "balance.channels",
+    "balance.clock",
     "balance.estimator",
     "balance.feedback",
     "balance.lqr",
@@ -43,7 +44,6 @@ NUMPY_ONLY = (
     "retarget.template",
     "runs",
     "sim",
-    "sim.clock",
     "sim.metrics",
     "sim.perturb",
     "sim.servo",

@@ -19,8 +19,8 @@ Two optional parts are the reference's, not feedback: a servo feedforward added 
 ``q_ref`` (``offsets``, :mod:`imitwalk.retarget.feedforward`), and the phase wait (``wait``,
 eq. 9's phase advance made by the sole forces): before a planned lift-off the reference's
 clock waits while the sole about to lift still carries more than ``wait`` of the
-measured load, at most :data:`~imitwalk.sim.clock.MAX_WAIT_S` per lift-off
-(:class:`~imitwalk.sim.clock.LoadClock`).
+measured load, at most :data:`~imitwalk.balance.clock.MAX_WAIT_S` per lift-off
+(:class:`~imitwalk.balance.clock.LoadClock`).
 """
 
 from __future__ import annotations
@@ -30,10 +30,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from imitwalk.balance.channels import FEATURES, channel_matrix, check_names
+from imitwalk.balance.clock import LoadClock
 from imitwalk.balance.estimator import StateEstimator
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
-from imitwalk.sim.clock import LoadClock
 
 __all__ = ["Episode", "FeedbackLaw", "TickPolicy"]
 

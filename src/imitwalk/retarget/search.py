@@ -18,14 +18,12 @@ import numpy as np
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.command import GaitCommand
-from imitwalk.retarget.feedforward import reference_offsets
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.params import leg_scaled
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
-from imitwalk.sim.clock import LoadClock
 from imitwalk.sim.metrics import walk_metrics
 from imitwalk.sim.mujoco import SimOptions, make_plant, playback
 from imitwalk.sim.perturb import perturbed, train_seeds
@@ -79,11 +77,6 @@ class SearchConfig:
             (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales);
             refine_early_stop: stop a nudge's trial once it has fallen more often than the
             set it must beat (the same nudges are kept; see :mod:`imitwalk.retarget.refine`).
-        feedforward: the fraction of the servo feedforward the candidates are played
-            with (:mod:`imitwalk.retarget.feedforward`; 0: none); wait: the load share
-            above which their clock waits before a lift-off
-            (:class:`~imitwalk.sim.clock.LoadClock`; 0: it never waits). Both as the
-            learner's trials may pick them (``trials.feedforward``, ``trials.wait``).
     """
 
     generations: int = 5
@@ -101,8 +94,6 @@ class SearchConfig:
     refine_seconds: float = 30.0
     refine_per_scale: bool = False
     refine_early_stop: bool = True
-    feedforward: float = 0.0
-    wait: float = 0.0
 
     def __post_init__(self):
         if self.engine not in ENGINES:
@@ -118,10 +109,6 @@ class SearchConfig:
             raise ConfigError(f"search_config.seconds: {self.seconds} is not above 0 s")
         if not self.scales or not all(0.0 < x <= 1.0 for x in self.scales):
             raise ConfigError(f"search_config.scales: {self.scales} must be scales in (0, 1]")
-        if not 0.0 <= self.feedforward <= 1.0:
-            raise ConfigError(f"search_config.feedforward: {self.feedforward:g} is not in 0..1")
-        if not 0.0 <= self.wait <= 0.95:
-            raise ConfigError(f"search_config.wait: {self.wait:g} is not in 0..0.95")
         if self.refine_rounds < 0:
             raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
         if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
@@ -144,15 +131,9 @@ def _trial(job) -> dict:
     base = ref.sim_options(base)
     runs, score = [], []
     for s in cfg.scales:
-        steps = len(ref.trajectory(s, cfg.seconds))
-        q = ref.trajectory(s, 2.0 * cfg.seconds)  # as far as a waiting clock may reach
-        if cfg.feedforward:
-            q = q + cfg.feedforward * reference_offsets(ref, robot, s, 2.0 * cfg.seconds)
-        down = ref.planned_load(s, len(q))[0] if cfg.wait else None
+        q = ref.trajectory(s, cfg.seconds)
         for seed in train_seeds(cfg.models):
-            clock = None if down is None else LoadClock(down, cfg.wait, ref.dt)
-            plant = make_plant(robot, perturbed(seed, base), cfg.engine)
-            ro = playback(plant, q, q0=q[0], clock=clock, steps=steps)
+            ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
             m = walk_metrics(
                 ro, ref.expected_distance(s, ro.seconds), track=ref.track(s, ro.seconds)
             )

@@ -24,7 +24,6 @@ import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.robots import Robot
-from imitwalk.sim.clock import LoadClock
 from imitwalk.sim.types import (
     ENGINES,
     Observation,
@@ -293,17 +292,7 @@ def playback(
     targets: np.ndarray,
     q0: np.ndarray | None = None,
     stop_on_fall: bool = True,
-    clock: LoadClock | None = None,
-    steps: int | None = None,
 ) -> Rollout:
-    """Play ``(N, n)`` joint targets, one row per control period, open loop, for ``steps``
-    periods (default ``N``). With ``clock`` (the phase wait on the soles' measured
-    forces), the row played is the clock's tick, and ``N`` must reach as far as it may."""
+    """Play ``(N, n)`` joint targets, one row per control period, open loop."""
     targets = np.asarray(targets, dtype=float)
-    last = len(targets) - 1
-
-    def policy(k: int, obs) -> np.ndarray:
-        return targets[k if clock is None else min(clock.tick(k, obs.foot_force), last)]
-
-    n = len(targets) if steps is None else steps
-    return run(plant, policy, n, q0=q0, stop_on_fall=stop_on_fall)
+    return run(plant, lambda k, _obs: targets[k], len(targets), q0=q0, stop_on_fall=stop_on_fall)

@@ -3,9 +3,8 @@ advance, held back before a lift-off while the foot is still loaded).
 
 Before a planned lift-off the clock stands still while the sole about to lift carries
 more than ``wait`` of the measured load, at most :data:`MAX_WAIT_S` per lift-off. It reads
-only the soles' force sensors. NumPy only: the per-tick policy
-(:class:`~imitwalk.balance.feedback.TickPolicy`) and open-loop playback
-(:func:`~imitwalk.sim.mujoco.playback`) both run it.
+only the soles' force sensors; the per-tick policy
+(:class:`~imitwalk.balance.feedback.TickPolicy`) runs it. NumPy only.
 """
 
 from __future__ import annotations
