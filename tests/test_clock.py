@@ -1,5 +1,5 @@
-"""The reference's clock made by the sole forces (the phase wait), on its own and in
-open-loop playback."""
+"""The reference's clock made by the sole forces (the phase wait), on its own (the
+per-tick policy's use of it: tests/test_feedforward.py)."""
 
 from __future__ import annotations
 
