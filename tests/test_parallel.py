@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
 import time
 
 import pytest
@@ -53,6 +57,52 @@ def test_a_stopped_map_hands_back_every_job_that_ran_beyond_its_prefix(tmp_path)
         ran = sorted(int(p.stem) for p in folder.iterdir())
         assert out == [0, 1, 4, 9]
         assert [x * x for x in ran[4:]] == spent  # in job order
+
+
+_INTERRUPTED = """
+import pathlib, sys, time
+from imitwalk.parallel import run_parallel
+
+def job(x):
+    time.sleep(0.1)
+    (pathlib.Path(sys.argv[1]) / str(x)).touch()
+    return x
+
+if __name__ == "__main__":
+    print("start", flush=True)
+    try:
+        run_parallel(job, list(range(200)), workers=2,
+                     stop=(lambda out: False) if sys.argv[2] == "stop" else None)
+    except KeyboardInterrupt:
+        sys.exit(130)
+"""
+
+
+@pytest.mark.parametrize("mode", ["map", "stop"])
+def test_ctrl_c_cancels_the_jobs_not_started_and_leaves_no_worker(tmp_path, mode):
+    """Ctrl-C reaches the whole process group, at any moment of a map: the parent raises
+    KeyboardInterrupt, the jobs not yet started never run, and no worker is left behind
+    (an idle worker interrupted while it waited for a job used to hang the pool)."""
+    script = tmp_path / "run.py"
+    script.write_text(_INTERRUPTED)
+    for delay in (0.0, 0.002, 0.01, 0.05, 0.3):
+        folder = tmp_path / f"{delay}"
+        folder.mkdir()
+        p = subprocess.Popen([sys.executable, str(script), str(folder), mode],
+                             stdout=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+        assert p.stdout is not None and p.stdout.readline().strip() == "start"
+        time.sleep(delay)
+        os.killpg(p.pid, signal.SIGINT)
+        try:
+            assert p.wait(timeout=120) == 130
+        finally:
+            ran = len(list(folder.iterdir()))
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+                left = True
+            except ProcessLookupError:
+                left = False
+        assert ran < 200 and not left, (delay, ran, left)
 
 
 def test_unknown_executor_lists_the_valid_ones(monkeypatch):

@@ -15,8 +15,11 @@ returned. Which prefix that is does not depend on the executor either.
 from __future__ import annotations
 
 import os
+import signal
+import threading
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 
 from imitwalk.errors import ConfigError, unknown_name
 
@@ -40,7 +43,9 @@ def run_parallel(
     the jobs are cancelled (those already running finish, unused) and the results so far
     are returned: the shortest prefix of ``[fn(j) for j in jobs]`` that ``stop`` accepts.
     ``spent``, if given, receives the results of the jobs beyond that prefix that ran to
-    their end all the same (unused, but paid for), in job order.
+    their end all the same (unused, but paid for), in job order. Ctrl-C (sent to the
+    whole process group, as a terminal does) raises ``KeyboardInterrupt`` here: the jobs
+    not yet started are cancelled, the running ones end, and no worker is left behind.
     """
     executor = os.environ.get("IMITWALK_EXECUTOR", "process")
     if executor not in EXECUTORS:
@@ -51,15 +56,43 @@ def run_parallel(
     workers = min(len(jobs), workers or default)
     if workers <= 1:
         return _until(jobs, fn, stop)
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        if stop is None:
-            return list(pool.map(fn, jobs))
-        futures = [pool.submit(fn, j) for j in jobs]
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_leave_ctrl_c_to_parent)
+    futures: list = []
+    try:
+        with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
+            futures = [pool.submit(fn, j) for j in jobs]
         out = _until(futures, lambda f: f.result(), stop)
         ran = [f for f in futures[len(out) :] if not f.cancel()]
         if spent is not None:
             spent.extend(f.result() for f in ran)
-        return out
+    except BaseException:  # Ctrl-C or a failed job: drop the jobs not yet started
+        for f in futures:
+            f.cancel()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+    return out
+
+
+@contextmanager
+def _ctrl_c_held():
+    """Hold Ctrl-C (SIGINT) back in this thread until the block ends, where it is raised."""
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = block(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, old)
+
+
+def _leave_ctrl_c_to_parent() -> None:
+    """A worker ignores Ctrl-C: the parent cancels the jobs not yet started and the
+    running ones end. (An idle worker interrupted while it waits for a job dies holding
+    the pool's queue, and the pool then waits for it forever.)"""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _until(pending, get: Callable, stop: Callable | None) -> list:
