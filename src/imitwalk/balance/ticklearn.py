@@ -43,6 +43,7 @@ from imitwalk.balance.ticktrials import (
     TickProgress,
     best,
     checkpoint,
+    fewest_falls,
     gains_key,
     say_table,
     trial,
@@ -130,8 +131,7 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
     for frac in cfg.lqr.trust:
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
         key = gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
-        top = best(table)
-        table.append((float(frac), trial(lr, state, key, laws, beat=top and top[1])))
+        table.append((float(frac), trial(lr, state, key, laws, fewest=fewest_falls(table))))
     kept = best(table)[0]
     state.trust, state.stage = kept, "done"
     log.append({"stage": "trust", "scale": lr.scales[-1], "kept": kept,

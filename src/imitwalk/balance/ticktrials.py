@@ -28,6 +28,7 @@ __all__ = [
     "TickProgress",
     "best",
     "checkpoint",
+    "fewest_falls",
     "gains_key",
     "say_table",
     "trial",
@@ -113,14 +114,14 @@ class Learner:
         return out
 
 
-def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, beat=None) -> Trial:
+def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, fewest=None) -> Trial:
     """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
     reference played with ``settings`` (default: the ones kept), run once per key (kept
     in the checkpoint, so that a resumed run neither repeats nor re-counts them).
 
-    With ``beat`` (the best candidate's :class:`Trial` so far), the walks stop once this
-    candidate has fallen more often than ``beat`` did on all its robots: it can then no
-    longer be kept, since :meth:`Trial.rank` orders by falls first. Every pick is the
+    With ``fewest`` (the fewest falls of the candidates so far, :func:`fewest_falls`),
+    the walks stop once this candidate has fallen more often: it can then no longer be
+    kept, since :meth:`Trial.rank` orders by falls first. Every pick is the
     same as without the cut (tested); only the cost falls. A cut trial is finished if a
     later use of its key needs the rest. The walks already running when it was cut are
     paid for (``sim_seconds``) but not kept, so that the trial is the same prefix of its
@@ -133,11 +134,11 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, beat
     key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
     key = f"{key}@{n}x{seconds:g}s"
     done = [TickResult(**r) for r in state.tried.get(key, [])]
-    limit = n if beat is None else beat.summary().falls
+    limit = n if fewest is None else fewest
     fell = sum(r.fell for r in done)
     if len(done) < n and fell <= limit:
-        draws = lr.robots(n, TRIAL_SEED_BASE + 1, seconds)[len(done) :]
-        stop = None if beat is None else (lambda out: fell + sum(r.fell for r in out) > limit)
+        draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds)
+        stop = None if fewest is None else (lambda out: fell + sum(r.fell for r in out) > limit)
         res = lr.run(state, lr.scales[-1], laws, draws, seconds, settings=settings,
                      first=len(done), stop=stop)  # fmt: skip
         done += res
@@ -146,9 +147,14 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, beat
 
 
 def best(table: list, yaw_limit_deg: float | None = None):
-    """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`); ``None``
-    for an empty table."""
-    return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg), default=None)
+    """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`)."""
+    return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
+
+
+def fewest_falls(table: list) -> int | None:
+    """The fewest falls of ``table``'s rows ``(value, Trial)`` (the kept row's, whatever
+    the tie-breaks, and a cut row's are always more); ``None`` for an empty table."""
+    return min((t.summary().falls for _, t in table), default=None)
 
 
 def gains_key(gains: dict) -> str:
@@ -176,8 +182,7 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
         table: list[tuple[float, Trial]] = []
         for value in candidates:
             settings = {**state.settings, name: float(value)}
-            top = best(table)
-            run = trial(lr, state, gains_key({}), laws, False, settings, top and top[1])
+            run = trial(lr, state, gains_key({}), laws, False, settings, fewest_falls(table))
             table.append((float(value), run))
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
@@ -198,8 +203,7 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         for value in getattr(cfg.trials, name):
             gains = {**state.gains, name: float(value)}
             laws = [feedback_law(cfg, gains)]
-            top = best(table, limit)
-            run = trial(lr, state, gains_key(gains), laws, steers, beat=top and top[1])
+            run = trial(lr, state, gains_key(gains), laws, steers, fewest=fewest_falls(table))
             table.append((float(value), run))
         state.gains[name] = kept = best(table, limit)[0]
         log.append(
