@@ -77,12 +77,16 @@ def test_a_tiny_run_writes_its_folder(tick_run):
         assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
         kept = next(r for r in entry["table"] if r["value"] == entry["kept"])
         assert kept["falls"] == min(r["falls"] for r in entry["table"])  # fewest falls first
-        assert all(r["robots"] == cfg.trials.robots for r in entry["table"])
+        assert kept["robots"] == cfg.trials.robots  # the kept law walked every trial robot
+        # the others walked until they could no longer be kept
+        assert all(r["robots"] <= cfg.trials.robots for r in entry["table"])
     schedule = [e for e in log if e["stage"] == "schedule"]
     assert len(schedule) == m["iterations"] >= 2
     assert schedule[0]["explore"] == cfg.lqr.explore and schedule[0]["held_out"] is None
     assert all(e["held_out"]["ratio_to_persistence"] > 0 for e in schedule[1:])
-    assert [r["fraction"] for r in log[-1]["table"]] == list(cfg.lqr.trust)
+    # the learned law first, so that its trial is whole
+    assert [r["fraction"] for r in log[-1]["table"]] == sorted(cfg.lqr.trust, reverse=True)
+    assert log[-1]["table"][0]["robots"] == cfg.trials.robots
     assert log[-1]["kept"] == m["trust"] and log[-1]["scale"] == max(m["scales_passed"])
     # every simulated second is accounted for: trials, schedule and trust
     # (each candidate's trials once: a candidate in two tables was walked once)

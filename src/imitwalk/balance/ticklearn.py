@@ -43,8 +43,8 @@ from imitwalk.balance.ticktrials import (
     TickProgress,
     best,
     checkpoint,
-    fewest_falls,
     gains_key,
+    most_falls,
     say_table,
     trial,
     trials,
@@ -121,17 +121,20 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
 
 def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
     """Stage 3: how much of the learned law to keep, by the trials at the top scale (the
-    law the schedule learned at the highest scale it passed)."""
+    law the schedule learned at the highest scale it passed). The largest fraction is
+    walked first, so that the learned law's trial is always whole: walked after the
+    trial-picked law alone, it would be stopped, or not walked at all, wherever that law
+    did not fall (:func:`~imitwalk.balance.ticktrials.most_falls`)."""
     cfg = lr.cfg
     if learned is None:
         state.trust, state.stage = 0.0, "done"
         return
     base = feedback_law(cfg, state.gains)
     table: list[tuple[float, Trial]] = []
-    for frac in cfg.lqr.trust:
+    for frac in sorted(cfg.lqr.trust, reverse=True):
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]
         key = gains_key(state.gains) + ("" if frac == 0 else f";learned x {frac:g}")
-        table.append((float(frac), trial(lr, state, key, laws, fewest=fewest_falls(table))))
+        table.append((float(frac), trial(lr, state, key, laws, most=most_falls(table, frac))))
     kept = best(table)[0]
     state.trust, state.stage = kept, "done"
     log.append({"stage": "trust", "scale": lr.scales[-1], "kept": kept,

@@ -135,34 +135,39 @@ class WalkSummary:
 
 
 def summarize(results: list[TickResult]) -> WalkSummary:
-    """:class:`WalkSummary` of ``results``."""
+    """:class:`WalkSummary` of ``results`` (over no walks: no falls, the means 0)."""
     up = [r for r in results if not r.fell]
+    mean = lambda xs: float(np.mean(xs)) if xs else 0.0  # noqa: E731  (no walks: 0)
     return WalkSummary(
         falls=int(sum(r.fell for r in results)),
         robots=len(results),
-        cost=float(np.mean([r.cost for r in up])) if up else float("inf"),
+        cost=mean([r.cost for r in up]) if up else float("inf"),
         walked_s=float(sum(r.seconds for r in results)),
-        distance_m=float(np.mean([r.distance_m for r in results])),
-        abs_yaw_deg=float(np.mean([abs(r.yaw_drift_deg) for r in results])),
+        distance_m=mean([r.distance_m for r in results]),
+        abs_yaw_deg=mean([abs(r.yaw_drift_deg) for r in results]),
     )
 
 
 @dataclass(frozen=True)
 class Trial:
-    """One candidate's walks at the top scale, on the training robots."""
+    """One candidate's walks at the top scale, on the training robots: ``results``, the
+    first of ``robots`` planned ones (``None``: all of them; fewer once a candidate that
+    can no longer be kept was stopped, :func:`~imitwalk.balance.ticktrials.trial`)."""
 
     results: list
+    robots: int | None = None
 
     def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
         """The order candidates are kept in (least first): the fewest falls; then, where
         the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
-        beyond that limit; where every robot fell, the longest walked; then the smallest
-        ``|value|``. A lower
+        beyond that limit; where every planned robot fell, the longest walked; then the
+        smallest ``|value|``. A lower
         Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
         the gain where robots start to fall (docs/RESULTS.md)."""
         s = self.summary()
         drift = 0.0 if yaw_limit_deg is None else max(0.0, s.abs_yaw_deg - yaw_limit_deg)
-        walked = -s.walked_s if s.falls == s.robots else 0.0
+        planned = s.robots if self.robots is None else self.robots
+        walked = -s.walked_s if s.falls == planned else 0.0
         return (s.falls, drift, walked, abs(value))
 
     def summary(self) -> WalkSummary:

@@ -28,8 +28,8 @@ __all__ = [
     "TickProgress",
     "best",
     "checkpoint",
-    "fewest_falls",
     "gains_key",
+    "most_falls",
     "say_table",
     "trial",
     "trials",
@@ -114,14 +114,14 @@ class Learner:
         return out
 
 
-def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, fewest=None) -> Trial:
+def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most=None) -> Trial:
     """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
     reference played with ``settings`` (default: the ones kept), run once per key (kept
     in the checkpoint, so that a resumed run neither repeats nor re-counts them).
 
-    With ``fewest`` (the fewest falls of the candidates so far, :func:`fewest_falls`),
-    the walks stop once this candidate has fallen more often: it can then no longer be
-    kept, since :meth:`Trial.rank` orders by falls first. Every pick is the
+    With ``most`` (the most falls this candidate may have and still be kept,
+    :func:`most_falls`), its walks stop once it has fallen more often, and with a
+    ``most`` below 0 it is not walked at all. Every pick is the
     same as without the cut (tested); only the cost falls. A cut trial is finished if a
     later use of its key needs the rest. The walks already running when it was cut are
     paid for (``sim_seconds``) but not kept, so that the trial is the same prefix of its
@@ -134,16 +134,16 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, fewe
     key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
     key = f"{key}@{n}x{seconds:g}s"
     done = [TickResult(**r) for r in state.tried.get(key, [])]
-    limit = n if fewest is None else fewest
+    limit = n if most is None else most
     fell = sum(r.fell for r in done)
     if len(done) < n and fell <= limit:
         draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds)
-        stop = None if fewest is None else (lambda out: fell + sum(r.fell for r in out) > limit)
+        stop = None if most is None else (lambda out: fell + sum(r.fell for r in out) > limit)
         res = lr.run(state, lr.scales[-1], laws, draws, seconds, settings=settings,
                      first=len(done), stop=stop)  # fmt: skip
         done += res
     state.tried[key] = [asdict(replace(r, episode=None)) for r in done]
-    return Trial(done)
+    return Trial(done, n)
 
 
 def best(table: list, yaw_limit_deg: float | None = None):
@@ -151,10 +151,22 @@ def best(table: list, yaw_limit_deg: float | None = None):
     return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
 
 
-def fewest_falls(table: list) -> int | None:
-    """The fewest falls of ``table``'s rows ``(value, Trial)`` (the kept row's, whatever
-    the tie-breaks, and a cut row's are always more); ``None`` for an empty table."""
-    return min((t.summary().falls for _, t in table), default=None)
+def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) -> int | None:
+    """The most falls a candidate ``value`` may have and still be kept, against the rows
+    ``(value, Trial)`` of ``table`` so far (``None`` for an empty table: no limit).
+
+    :meth:`Trial.rank` orders by falls first, so a candidate is out once it has fallen
+    more often than the best row. A tie loses too where the rest of the rank already
+    favours the best row: not every one of its robots fell, it kept the heading's drift
+    within ``yaw_limit_deg``, and its ``|value|`` is the smaller. Then the most is one
+    fall fewer, and against a best row with no falls the candidate is not walked at all
+    (it could at best tie, and lose on the smaller value)."""
+    if not table:
+        return None
+    v, t = best(table, yaw_limit_deg)
+    s, rank = t.summary(), t.rank(v, yaw_limit_deg)
+    ties_lose = rank[1] == 0.0 and rank[2] == 0.0 and abs(value) > abs(v)
+    return s.falls - 1 if ties_lose else s.falls
 
 
 def gains_key(gains: dict) -> str:
@@ -167,7 +179,8 @@ def say_table(lr: Learner, head: str, table) -> None:
     cells = []
     for v, t in table:
         s = t.summary()
-        cells.append(f"[{v:g}: {s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg]")
+        walked = f"{s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg" if s.robots else "not walked"
+        cells.append(f"[{v:g}: {walked}]")
     lr.say(f"{head} {' '.join(cells)}")
 
 
@@ -182,7 +195,7 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
         table: list[tuple[float, Trial]] = []
         for value in candidates:
             settings = {**state.settings, name: float(value)}
-            run = trial(lr, state, gains_key({}), laws, False, settings, fewest_falls(table))
+            run = trial(lr, state, gains_key({}), laws, False, settings, most_falls(table, value))
             table.append((float(value), run))
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
@@ -203,7 +216,8 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         for value in getattr(cfg.trials, name):
             gains = {**state.gains, name: float(value)}
             laws = [feedback_law(cfg, gains)]
-            run = trial(lr, state, gains_key(gains), laws, steers, fewest=fewest_falls(table))
+            most = most_falls(table, value, limit)
+            run = trial(lr, state, gains_key(gains), laws, steers, most=most)
             table.append((float(value), run))
         state.gains[name] = kept = best(table, limit)[0]
         log.append(
