@@ -101,7 +101,7 @@ class LqrConfig:
         explore: exploration amplitude [rad] in a scale's first iteration.
         box: each channel's limit [rad].
         trust: the fractions of the learned law tried at the top scale (its gains ×
-            each); the smallest that falls least is kept.
+            each), the largest first; the smallest that falls least is kept.
     """
 
     enabled: bool = True
