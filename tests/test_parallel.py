@@ -60,8 +60,12 @@ def test_a_stopped_map_hands_back_every_job_that_ran_beyond_its_prefix(tmp_path)
 
 
 _INTERRUPTED = """
-import pathlib, sys, time
+import pathlib, signal, sys, time
 from imitwalk.parallel import run_parallel
+
+# as a terminal's Ctrl-C finds it: a shell that ran the tests in the background left
+# SIGINT ignored, and Python then installs no KeyboardInterrupt
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 def job(x):
     time.sleep(0.1)
