@@ -164,9 +164,9 @@ def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) ->
     if not table:
         return None
     v, t = best(table, yaw_limit_deg)
-    s, rank = t.summary(), t.rank(v, yaw_limit_deg)
-    ties_lose = rank[1] == 0.0 and rank[2] == 0.0 and abs(value) > abs(v)
-    return s.falls - 1 if ties_lose else s.falls
+    falls, drift, walked, _ = t.rank(v, yaw_limit_deg)
+    ties_lose = drift == 0.0 and walked == 0.0 and abs(value) > abs(v)
+    return falls - 1 if ties_lose else falls
 
 
 def gains_key(gains: dict) -> str:
