@@ -44,6 +44,21 @@ def test_evaluate_judges_every_controller_and_writes_the_protocols_file(run, cap
     assert RunDir(run).exists("protocol_hard.json")
 
 
+def test_evaluate_explains_the_falls_when_asked(run, capsys):
+    argv = ["evaluate", str(run), "--seconds", "4", "--seeds", "2", "--workers", "1",
+            "--protocol", "hard", "--controllers", "fixed", "--explain-falls",
+            "--json"]  # fmt: skip
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    side = json.loads(cap.out)["controllers"]["fixed"]
+    assert side["falls"] > 0 and "falls saved by one factor at nominal:" in cap.err
+    assert sum(r["saved_by"] is not None for r in side["per_seed"]) == side["falls"]
+    assert (
+        side["falls_no_single_factor"] + sum(side["falls_saved_by_factor"].values())
+        >= side["falls"]
+    )
+
+
 @pytest.mark.parametrize(
     ("args", "expect"),
     [

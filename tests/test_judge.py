@@ -106,3 +106,41 @@ def test_a_verdict_file_of_another_layout_is_a_one_line_error():
         ProtocolVerdict.from_dict(old, "old.json")
     with pytest.raises(RunError, match=r"^p\.json: not a push-recovery table"):
         PushVerdict.from_dict({"controllers": {}}, "p.json")
+
+
+def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_run, robot):
+    from dataclasses import replace
+
+    from imitwalk.judge.verdict import JudgeJob, run_controller
+
+    protocol = load_protocol("hard")
+    out = judge_protocol(tick_run, robot, protocol, SEEDS, SECONDS, ("fixed",), workers=1,
+                         explain=True)  # fmt: skip
+    side = out.controllers["fixed"]
+    assert side.falls > 0  # hard's robots fall in 6 s on this tiny run
+    for r in side.per_seed:
+        assert (r.saved_by is None) == (not r.fell)
+    saved = {r.seed: r.saved_by for r in side.per_seed if r.fell}
+    assert side.falls_no_single_factor == sum(not s for s in saved.values())
+    assert side.falls_saved_by_factor == {
+        f: sum(f in s for s in saved.values()) for f in protocol.factors
+    }
+    # each named factor, taken away, does let that robot walk; each other one does not
+    seed = next(iter(saved))
+    for factor in protocol.factors:
+        rest = protocol.only([f for f in protocol.factors if f != factor])
+        d = rest.draw(seed, robot, seconds=SECONDS)
+        job = JudgeJob(str(tick_run), robot, "fixed", seed, d.options, None, SECONDS, None,
+                       "mujoco")  # fmt: skip
+        walk = run_controller(replace(job))
+        assert walk.metrics.fell == (factor not in saved[seed]), factor
+    back = ProtocolVerdict.from_dict(json.loads(json.dumps(out.to_dict())))
+    assert back == out
+    # verdicts written before falls could be explained still load
+    old = out.to_dict()
+    for c in old["controllers"].values():
+        del c["falls_saved_by_factor"], c["falls_no_single_factor"]
+        for r in c["per_seed"]:
+            del r["saved_by"]
+    plain = ProtocolVerdict.from_dict(old).controllers["fixed"]
+    assert plain.falls_saved_by_factor is None and plain.per_seed[0].saved_by is None

@@ -6,6 +6,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from imitwalk.cli.main import main
 from imitwalk.errors import ConfigError
@@ -150,3 +152,36 @@ def test_cli_bad_protocol_exits_2(tmp_path, capsys, protocol, expect):
     assert main(["evaluate", str(run), "--protocol", protocol]) == 2
     err = capsys.readouterr().err
     assert expect in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+#: The options each factor of a protocol sets (the rest stay as drawn without it).
+FIELDS = {
+    "friction": ("friction",),
+    "mass": ("mass_jitter",),
+    "servo": ("kp_jitter",),
+    "torso_com": ("com_shift",),
+    "gyro_noise": ("gyro_noise",),
+    "accel_noise": ("accel_noise",),
+    "servo_delay": ("servo_delay",),
+    "slope": ("slope_deg",),
+    "pushes": ("pushes",),
+    "initial_twist": ("init_twist",),
+}
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(1, 10**6), name=st.sampled_from(["eval", "hard"]))
+def test_a_factor_left_out_is_nominal_and_every_other_is_drawn_as_before(robot, seed, name):
+    """What ``evaluate --explain-falls`` relies on: ``only`` without one factor draws
+    the same robot but for that factor, which is at nominal."""
+    from dataclasses import fields
+
+    protocol = load_protocol(name)
+    full = protocol.draw(seed, robot, seconds=12.0).options
+    nominal = SimOptions()
+    for factor in protocol.factors:
+        rest = [f for f in protocol.factors if f != factor]
+        less = protocol.only(rest).draw(seed, robot, seconds=12.0).options
+        for f in fields(SimOptions):
+            want = getattr(nominal if f.name in FIELDS[factor] else full, f.name)
+            assert getattr(less, f.name) == want, (factor, f.name)

@@ -181,6 +181,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="which of the run's controllers (default: all of them, open_loop included)",
     )
     ev.add_argument(
+        "--explain-falls",
+        action="store_true",
+        help="walk each fall again once per factor, that factor at nominal, and name the "
+        "factors whose removal alone saves it",
+    )
+    ev.add_argument(
         "--push-recovery",
         action="store_true",
         help="instead: the largest kick survived, by direction and gait phase (nominal robot)",

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from imitwalk.errors import RunError
 
@@ -48,7 +48,9 @@ class SeedRow:
         seed: the protocol's robot; fell: it fell; fall_time_s: when [s] (``None``: it did
         not); forward_distance_m: torso travel along the heading [m]; furthest: the factor
         the robot drew furthest from nominal; yaw_drift_deg: heading change beyond the
-        commanded turn [deg].
+        commanded turn [deg]; saved_by: for a fall explained by
+        :func:`~imitwalk.judge.explain.explain_falls`, the factors whose removal alone
+        lets it walk (empty: none does); ``None``: not asked, or it did not fall.
     """
 
     seed: int
@@ -57,6 +59,7 @@ class SeedRow:
     forward_distance_m: float
     furthest: str | None
     yaw_drift_deg: float
+    saved_by: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -68,7 +71,10 @@ class ControllerVerdict:
         interval ``survival_ci95``; distance_m [m], speed_mps [m/s], abs_yaw_deg [deg]:
         means over the robots (``None`` for none); progress_ratio_min: the slowest robot's;
         falls_by_furthest_factor: falls counted under the factor each robot drew furthest
-        from nominal; per_seed: the robots' rows, in seed order.
+        from nominal; per_seed: the robots' rows, in seed order;
+        falls_saved_by_factor: with the falls explained, factor → the falls its removal
+        alone saves (a fall saved by two factors counts under both), and
+        falls_no_single_factor: the falls no single removal saves (``None``: not asked).
     """
 
     robots: int
@@ -82,21 +88,45 @@ class ControllerVerdict:
     progress_ratio_min: float | None
     falls_by_furthest_factor: dict[str, int]
     per_seed: tuple[SeedRow, ...]
+    falls_saved_by_factor: dict[str, int] | None = None
+    falls_no_single_factor: int | None = None
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
         out = asdict(self)
         out["survival_ci95"] = list(self.survival_ci95)
-        out["per_seed"] = [asdict(r) for r in self.per_seed]
+        out["per_seed"] = [_row_dict(r) for r in self.per_seed]
         return out
 
     @classmethod
     def from_dict(cls, d: dict) -> ControllerVerdict:
         """The record :meth:`to_dict` wrote."""
-        rows = tuple(SeedRow(**{f.name: r[f.name] for f in fields(SeedRow)}) for r in d["per_seed"])
+        rows = tuple(_row(r) for r in d["per_seed"])
         lo, hi = d["survival_ci95"]
-        own = {f.name: d[f.name] for f in fields(cls)}
+        own: dict[str, Any] = {
+            f.name: d[f.name] if f.name in d or not _optional(f) else None for f in fields(cls)
+        }
         return cls(**{**own, "survival_ci95": (float(lo), float(hi)), "per_seed": rows})
+
+
+def _optional(f) -> bool:
+    """A field later releases added, with a default (files written before lack it)."""
+    return f.default is None
+
+
+def _row_dict(r: SeedRow) -> dict:
+    out = asdict(r)
+    out["saved_by"] = None if r.saved_by is None else list(r.saved_by)
+    return out
+
+
+def _row(r: dict) -> SeedRow:
+    own: dict[str, Any] = {
+        f.name: r[f.name] if f.name in r or not _optional(f) else None for f in fields(SeedRow)
+    }
+    if own["saved_by"] is not None:
+        own["saved_by"] = tuple(own["saved_by"])
+    return SeedRow(**own)
 
 
 @dataclass(frozen=True)

@@ -4,9 +4,10 @@
 and walks each controller the run can build on every one of them, for ``seconds``
 from standing. Per controller it reports survival with its 95 % Wilson interval,
 distance, speed and mean |yaw| drift, and the falls broken down by the factor each
-robot drew furthest from nominal; every controller is compared with open loop on the
-same robots by the paired McNemar test. Robot ``s`` is the same robot whatever the
-controller, so the comparison is paired.
+robot drew furthest from nominal (and, if asked, by the factors whose removal alone
+saves it: :mod:`imitwalk.judge.explain`); every controller is compared with open loop
+on the same robots by the paired McNemar test. Robot ``s`` is the same robot whatever
+the controller, so the comparison is paired.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.judge.explain import explain_falls
 from imitwalk.judge.protocol import Protocol
 from imitwalk.judge.records import (
     ControllerVerdict,
@@ -66,11 +68,18 @@ class RobotWalk:
     furthest: str | None
     metrics: WalkMetrics
 
-    def row(self) -> SeedRow:
-        """Its row in a verdict."""
+    def row(self, saved_by: tuple[str, ...] | None = None) -> SeedRow:
+        """Its row in a verdict (``saved_by``: its fall explained, see
+        :func:`~imitwalk.judge.explain.explain_falls`)."""
         m = self.metrics
         return SeedRow(
-            self.seed, m.fell, m.fall_time_s, m.forward_distance_m, self.furthest, m.yaw_drift_deg
+            self.seed,
+            m.fell,
+            m.fall_time_s,
+            m.forward_distance_m,
+            self.furthest,
+            m.yaw_drift_deg,
+            saved_by,
         )
 
 
@@ -105,7 +114,11 @@ def run_controller(job: JudgeJob) -> RobotWalk:
     return RobotWalk(job.seed, job.furthest, m)
 
 
-def _side(runs: list[RobotWalk], factors) -> ControllerVerdict:
+def _side(
+    runs: list[RobotWalk], factors, saved: dict[int, tuple] | None = None
+) -> ControllerVerdict:
+    """One controller's verdict (``saved``: seed → the factors saving its fall, if
+    the falls were explained)."""
     n = len(runs)
     ms = [r.metrics for r in runs]
     falls = int(sum(m.fell for m in ms))
@@ -129,7 +142,11 @@ def _side(runs: list[RobotWalk], factors) -> ControllerVerdict:
         abs_yaw_deg=mean([abs(m.yaw_drift_deg) for m in ms]),
         progress_ratio_min=float(min(m.progress_ratio for m in ms)) if runs else None,
         falls_by_furthest_factor=by,
-        per_seed=tuple(r.row() for r in runs),
+        per_seed=tuple(r.row(None if saved is None else saved.get(r.seed)) for r in runs),
+        falls_saved_by_factor=None
+        if saved is None
+        else {f: sum(f in s for s in saved.values()) for f in factors},
+        falls_no_single_factor=None if saved is None else sum(not s for s in saved.values()),
     )
 
 
@@ -142,10 +159,13 @@ def judge_protocol(
     controllers: tuple[str, ...] | None = None,
     scale: float | None = None,
     workers: int | None = None,
+    explain: bool = False,
 ) -> ProtocolVerdict:
     """Every controller in ``controllers`` (``None``: every one the run can build) on
     robots ``0 … seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per controller,
-    and each one's falls compared with open loop's on the same robots (McNemar)."""
+    and each one's falls compared with open loop's on the same robots (McNemar).
+    ``explain``: also walk each fall again once per factor, that factor at nominal
+    (:func:`~imitwalk.judge.explain.explain_falls`)."""
     loaded = _loaded(str(run_dir))
     valid = loaded.controllers()
     controllers = valid if controllers is None else tuple(controllers)
@@ -174,6 +194,11 @@ def judge_protocol(
         c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
         for c in controllers
     }
+    saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(controllers)
+    if explain:
+        why = explain_falls(jobs, res, protocol, robot, seconds, workers)
+        for c in controllers:
+            saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
     comparison = {}
     if OPEN_LOOP in by:
         base = [r.metrics.fell for r in by[OPEN_LOOP]]
@@ -189,6 +214,6 @@ def judge_protocol(
             scale=scale if scale is not None else loaded.metrics.scale_reached,
             controllers=tuple(controllers),
         ),
-        controllers={c: _side(runs, protocol.factors) for c, runs in by.items()},
+        controllers={c: _side(runs, protocol.factors, saved[c]) for c, runs in by.items()},
         comparison=comparison,
     )

@@ -1,0 +1,71 @@
+"""Why a robot fell: each of its drawn factors set back to nominal, one at a time.
+
+A protocol's robot draws every factor at once, and the factor drawn furthest from
+nominal (:attr:`~imitwalk.judge.protocol.RobotDraw.furthest`) need not be the one that
+fells it. Eval's seed 14, for example, drew its initial twist furthest from nominal, yet
+it walks with the twist taken away and does not walk with its servo stiffnesses alone
+taken away. :func:`explain_falls` walks every fallen robot again once per factor of the
+protocol, with that factor at nominal and every other one exactly as drawn
+(:meth:`~imitwalk.judge.protocol.Protocol.only` keeps each factor's own draws), and names
+the factors whose removal alone lets the robot walk the whole time. A fall that no single
+removal saves comes from several factors together, or, on the nominal robot, from none.
+
+The cost is one walk per fall and factor, so it is asked for (``imitwalk evaluate
+--explain-falls``), never implied.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from imitwalk.judge.protocol import Protocol
+from imitwalk.parallel import run_parallel
+
+__all__ = ["explain_falls"]
+
+
+def explain_falls(
+    jobs: list, walks: list, protocol: Protocol, robot, seconds: float, workers: int | None = None
+) -> dict[tuple[str, int], tuple[str, ...]]:
+    """The factors whose removal alone saves each fallen robot.
+
+    Args:
+        jobs: the judge's :class:`~imitwalk.judge.verdict.JudgeJob` list; walks: their
+            :class:`~imitwalk.judge.verdict.RobotWalk` results, in the same order.
+        protocol: the protocol the robots were drawn from; robot: the robot;
+        seconds: simulated time per walk [s] (pushes are drawn up to it, as the judge's).
+        workers: parallel processes (``None``: one per core).
+
+    Returns:
+        ``(controller, seed)`` → the factors, in the protocol's order, whose removal
+        alone lets that fallen robot walk ``seconds`` (empty: none does). Robots that
+        did not fall are not listed.
+    """
+    from imitwalk.judge.verdict import run_controller  # the judge imports this module
+
+    factors = tuple(protocol.factors)
+    without = {f: protocol.only([g for g in factors if g != f]) for f in factors}
+    retry, keys = [], []
+    for job, walk in zip(jobs, walks, strict=True):
+        if not walk.metrics.fell:
+            continue
+        keys.append((job.controller, job.seed))
+        if protocol.nominal_first and job.seed == 0:
+            continue  # the nominal robot: no factor to take away
+        for f in factors:
+            options = without[f].draw(job.seed, robot, seconds=seconds).options
+            retry.append(replace(job, options=options))
+    if not retry:
+        return dict.fromkeys(keys, ())
+    res = run_parallel(run_controller, retry, workers)
+    out: dict[tuple[str, int], tuple[str, ...]] = {}
+    at = 0
+    for controller, seed in keys:
+        if protocol.nominal_first and seed == 0:
+            out[controller, seed] = ()
+            continue
+        part, at = res[at : at + len(factors)], at + len(factors)
+        out[controller, seed] = tuple(
+            f for f, r in zip(factors, part, strict=True) if not r.metrics.fell
+        )
+    return out
