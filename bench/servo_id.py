@@ -11,7 +11,8 @@ would have. Encoders only; ``--tau`` is the forgetting time [s].
 ``--exact`` scales the lag measured at this tick, (1/r − 1)·(target − encoder), instead of
 e_nom(ψ): at the control ticks a servo of stiffness r·kp then pulls as the nominal one
 would. ``--by-tick`` records e_nom per tick of the walk instead of per loop tick.
-``--oracle`` (a diagnosis, not a controller) skips the identification and holds each
+``--track G`` identifies nothing: it adds G × (the lag now − e_nom(ψ)) to each target,
+pulling every robot's joints toward the nominal robot's. ``--oracle`` (a diagnosis, not a controller) skips the identification and holds each
 servo's true factor, read from the simulator. ``--pattern P`` instead keeps only some
 servos' drawn stiffness (the others nominal) and walks the run's controller plainly:
 ``all``, ``uniform`` (every servo at the robot's mean factor), ``sym`` (each right servo
@@ -19,7 +20,7 @@ as its left twin), ``legs``, ``upper``, ``pitch`` (hip pitch, knee, ankle pitch)
 (hip and ankle roll).
 
 Usage: ``python bench/servo_id.py RUN --controller learned --protocol eval --robots 40
-[--taus 0,2] [--only servo] [--first 0] [--exact] [--by-tick] [--oracle] [--pattern P]``;
+[--taus 0,2] [--only servo] [--first 0] [--exact] [--by-tick] [--track G] [--oracle] [--pattern P]``;
 prints JSON lines: the falls per setting.
 """
 
@@ -41,6 +42,7 @@ class ServoId:
 
     def __init__(self, base, ref, e_nom: np.ndarray, tau_s: float, dt: float, exact=False):
         self.exact = exact
+        self.track = 0.0  # > 0: no identification; that gain on the lag's departure from e_nom
         self.by_tick = len(e_nom) != ref.loops.shape[1]
         self.base, self.e_nom = base, e_nom
         self.start, self.n_loop = ref.starts.shape[1], ref.loops.shape[1]
@@ -71,7 +73,9 @@ class ServoId:
             self.inv_r = np.where(
                 ok, np.clip(self.sxy / np.maximum(self.sxx, 1e-12), 0.7, 1.4), 1.0
             )
-        if i is not None:
+        if i is not None and self.track:
+            q = q + self.mask * self.track * ((q - obs.joints) - self.e_nom[i])
+        elif i is not None:
             lag = (q - obs.joints) if self.exact else self.e_nom[i]
             q = q + self.mask * (self.inv_r - 1.0) * lag
         self.prev, self.prev_i = q, i
@@ -140,7 +144,7 @@ def walk(job):
     import imitwalk.sim.mujoco as sim
     from imitwalk.sim.types import jitter_draws
 
-    run_dir, controller, seed, proto, only, tau, e_nom, seconds, exact, oracle, pattern = job
+    run_dir, controller, seed, proto, only, tau, e_nom, seconds, exact, oracle, pattern, track = job
     robot = load_robot("hoap2")
     if pattern:
         sim.jitter_draws = patterned(list(robot.joint_names), pattern)
@@ -153,6 +157,7 @@ def walk(job):
     plant = sim.make_plant(robot, lr.ref.sim_options(d.options))
     if tau > 0 and not pattern:
         pol = ServoId(pol, lr.ref, e_nom, tau, lr.ref.dt, exact)
+        pol.track = track
         if oracle:  # the true factors, held: a diagnosis of the compensation alone
             _, kp = jitter_draws(plant.options, plant.model.nbody, tuple(robot.joint_names))
             pol.mask[:] = True
@@ -174,6 +179,7 @@ def main():
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--by-tick", action="store_true", help="e_nom per tick of the walk")
     ap.add_argument("--exact", action="store_true", help="scale the lag measured now, not e_nom")
+    ap.add_argument("--track", type=float, default=0.0, help="gain on the lag less e_nom")
     ap.add_argument("--oracle", action="store_true", help="the true factors (a diagnosis)")
     ap.add_argument("--pattern", default="", help="which servos keep their draw (no --taus)")
     a = ap.parse_args()
@@ -183,14 +189,14 @@ def main():
     for tau in taus:
         jobs = [
             (a.run_dir, a.controller, a.first + s, a.protocol, a.only, tau, e_nom, a.seconds,
-             a.exact, a.oracle, a.pattern)
+             a.exact, a.oracle, a.pattern, a.track)
             for s in range(a.robots)
         ]  # fmt: skip
         res = run_parallel(walk, jobs, None)
         falls = [a.first + s for s, (f, _) in enumerate(res) if f]
         row = {"tau_s": tau, "protocol": a.protocol, "only": a.only, "controller": a.controller,
-               "exact": a.exact, "oracle": a.oracle, "pattern": a.pattern, "falls": len(falls),
-               "of": a.robots, "fallen": falls}  # fmt: skip
+               "exact": a.exact, "oracle": a.oracle, "pattern": a.pattern, "track": a.track,
+               "falls": len(falls), "of": a.robots, "fallen": falls}  # fmt: skip
         print(json.dumps(row), flush=True)
 
 
