@@ -144,3 +144,18 @@ def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_ru
             del r["saved_by"]
     plain = ProtocolVerdict.from_dict(old).controllers["fixed"]
     assert plain.falls_saved_by_factor is None and plain.per_seed[0].saved_by is None
+
+
+def test_the_reports_table_lists_the_explained_falls(judged):
+    from dataclasses import replace
+
+    from imitwalk.judge.tables import protocol_table
+
+    assert "one factor alone" not in protocol_table(judged)
+    sides = {name: replace(s, falls_saved_by_factor={"pushes": s.falls}, falls_no_single_factor=0)
+             for name, s in judged.controllers.items()}  # fmt: skip
+    html = protocol_table(replace(judged, controllers=sides))
+    falling = [n for n, s in sides.items() if s.falls]
+    assert falling and "one factor alone back to nominal" in html
+    for name in falling:
+        assert f"<li>{name}: pushes {sides[name].falls}; by no single factor: 0</li>" in html

@@ -48,7 +48,24 @@ def protocol_table(result: ProtocolVerdict) -> str:
         f", scale {st.scale}. A fall is counted under the factor its robot drew "
         "furthest from nominal.</p>"
     )
-    return caption + "<table>" + head + "".join(rows) + "</table>"
+    return caption + "<table>" + head + "".join(rows) + "</table>" + _explained(sides)
+
+
+def _explained(sides) -> str:
+    """The falls explained (``evaluate --explain-falls``), one line per controller."""
+    lines = []
+    for name, s in sides.items():
+        if s.falls_saved_by_factor is None or not s.falls:
+            continue
+        saved = ", ".join(f"{html.escape(f)} {n}" for f, n in s.falls_saved_by_factor.items() if n)
+        lines.append(
+            f"<li>{html.escape(name)}: {saved or 'none'}; by no single factor: "
+            f"{s.falls_no_single_factor}</li>"
+        )
+    if not lines:
+        return ""
+    head = "<p>Falls saved by setting one factor alone back to nominal:</p>"
+    return head + "<ul>" + "".join(lines) + "</ul>"
 
 
 def push_table(result: PushVerdict) -> str:
