@@ -16,6 +16,7 @@ The cost is one walk per fall and factor, so it is asked for (``imitwalk evaluat
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 from imitwalk.judge.protocol import Protocol
@@ -25,11 +26,19 @@ __all__ = ["explain_falls"]
 
 
 def explain_falls(
-    jobs: list, walks: list, protocol: Protocol, robot, seconds: float, workers: int | None = None
+    walker: Callable,
+    jobs: list,
+    walks: list,
+    protocol: Protocol,
+    robot,
+    seconds: float,
+    workers: int | None = None,
 ) -> dict[tuple[str, int], tuple[str, ...]]:
     """The factors whose removal alone saves each fallen robot.
 
     Args:
+        walker: ``walker(job) -> RobotWalk``, run in worker processes
+            (:func:`imitwalk.judge.verdict.run_controller`, passed in by the judge);
         jobs: the judge's :class:`~imitwalk.judge.verdict.JudgeJob` list; walks: their
             :class:`~imitwalk.judge.verdict.RobotWalk` results, in the same order.
         protocol: the protocol the robots were drawn from; robot: the robot;
@@ -41,8 +50,6 @@ def explain_falls(
         alone lets that fallen robot walk ``seconds`` (empty: none does). Robots that
         did not fall are not listed.
     """
-    from imitwalk.judge.verdict import run_controller  # the judge imports this module
-
     factors = tuple(protocol.factors)
     without = {f: protocol.only([g for g in factors if g != f]) for f in factors}
     retry, keys = [], []
@@ -57,7 +64,7 @@ def explain_falls(
             retry.append(replace(job, options=options))
     if not retry:
         return dict.fromkeys(keys, ())
-    res = run_parallel(run_controller, retry, workers)
+    res = run_parallel(walker, retry, workers)
     out: dict[tuple[str, int], tuple[str, ...]] = {}
     at = 0
     for controller, seed in keys:

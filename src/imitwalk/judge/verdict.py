@@ -196,7 +196,7 @@ def judge_protocol(
     }
     saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(controllers)
     if explain:
-        why = explain_falls(jobs, res, protocol, robot, seconds, workers)
+        why = explain_falls(run_controller, jobs, res, protocol, robot, seconds, workers)
         for c in controllers:
             saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
     comparison = {}
