@@ -3,8 +3,8 @@
 A protocol's robot draws every factor at once, and the factor drawn furthest from
 nominal (:attr:`~imitwalk.judge.protocol.RobotDraw.furthest`) need not be the one that
 fells it. Eval's seed 14, for example, drew its initial twist furthest from nominal, yet
-it walks with the twist taken away and does not walk with its servo stiffnesses alone
-taken away. :func:`explain_falls` walks every fallen robot again once per factor of the
+under the default clip's learned controller it still falls with the twist taken away,
+and walks with its servo stiffnesses alone set back to nominal. :func:`explain_falls` walks every fallen robot again once per factor of the
 protocol, with that factor at nominal and every other one exactly as drawn
 (:meth:`~imitwalk.judge.protocol.Protocol.only` keeps each factor's own draws), and names
 the factors whose removal alone lets the robot walk the whole time. A fall that no single
