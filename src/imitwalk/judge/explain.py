@@ -4,11 +4,13 @@ A protocol's robot draws every factor at once, and the factor drawn furthest fro
 nominal (:attr:`~imitwalk.judge.protocol.RobotDraw.furthest`) need not be the one that
 fells it. Eval's seed 14, for example, drew its initial twist furthest from nominal, yet
 under the default clip's learned controller it still falls with the twist taken away,
-and walks with its servo stiffnesses alone set back to nominal. :func:`explain_falls` walks every fallen robot again once per factor of the
-protocol, with that factor at nominal and every other one exactly as drawn
-(:meth:`~imitwalk.judge.protocol.Protocol.only` keeps each factor's own draws), and names
-the factors whose removal alone lets the robot walk the whole time. A fall that no single
-removal saves comes from several factors together, or, on the nominal robot, from none.
+and walks with its servo stiffnesses alone set back to nominal. :func:`explain_falls`
+walks every fallen robot again once per factor of the protocol, with that factor at
+nominal and every other one exactly as drawn
+(:meth:`~imitwalk.judge.protocol.Protocol.only` keeps each factor's own draws), and
+names the factors whose removal alone lets the robot walk the whole time. A fall that no
+single removal saves comes from several factors together, or, on the nominal robot, from
+none.
 
 The cost is one walk per fall and factor, so it is asked for (``imitwalk evaluate
 --explain-falls``), never implied.
