@@ -109,8 +109,6 @@ def test_a_verdict_file_of_another_layout_is_a_one_line_error():
 
 
 def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_run, robot):
-    from dataclasses import replace
-
     from imitwalk.judge.verdict import JudgeJob, run_controller
 
     protocol = load_protocol("hard")
@@ -132,7 +130,7 @@ def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_ru
         d = rest.draw(seed, robot, seconds=SECONDS)
         job = JudgeJob(str(tick_run), robot, "fixed", seed, d.options, None, SECONDS, None,
                        "mujoco")  # fmt: skip
-        walk = run_controller(replace(job))
+        walk = run_controller(job)
         assert walk.metrics.fell == (factor not in saved[seed]), factor
     back = ProtocolVerdict.from_dict(json.loads(json.dumps(out.to_dict())))
     assert back == out
