@@ -223,12 +223,8 @@ def evaluate(args: argparse.Namespace) -> int:
             f"({100 * lo:.0f}-{100 * hi:.0f} %), {side.distance_m:.2f} m, "
             f"|yaw| {side.abs_yaw_deg:.1f} deg"
         )
-        if side.falls_saved_by_factor is not None and side.falls:
-            saved = [f"{f} {n}" for f, n in side.falls_saved_by_factor.items() if n]
-            progress(
-                f"  {'':>10}  falls saved by one factor at nominal: {', '.join(saved) or 'none'}"
-                f"; by no single factor: {side.falls_no_single_factor}"
-            )
+        if (line := side.explained()) is not None:
+            progress(f"  {'':>10}  falls saved by one factor at nominal: {line}")
     scale = "" if args.scale is None else f"_scale{args.scale:g}"
     rd.write_json(f"protocol_{protocol.name}{scale}.json", out.to_dict())
     emit(out.to_dict(), args.json)

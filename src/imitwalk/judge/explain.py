@@ -54,27 +54,20 @@ def explain_falls(
     """
     factors = tuple(protocol.factors)
     without = {f: protocol.only([g for g in factors if g != f]) for f in factors}
-    retry, keys = [], []
+    retry, asked = [], []
     for job, walk in zip(jobs, walks, strict=True):
         if not walk.metrics.fell:
             continue
-        keys.append((job.controller, job.seed))
-        if protocol.nominal_first and job.seed == 0:
-            continue  # the nominal robot: no factor to take away
-        for f in factors:
+        # the nominal robot (seed 0 of a nominal-first protocol) has no factor to take away
+        tried = () if protocol.nominal_first and job.seed == 0 else factors
+        asked.append(((job.controller, job.seed), tried))
+        for f in tried:
             options = without[f].draw(job.seed, robot, seconds=seconds).options
             retry.append(replace(job, options=options))
-    if not retry:
-        return dict.fromkeys(keys, ())
-    res = run_parallel(walker, retry, workers)
+    res = run_parallel(walker, retry, workers) if retry else []
     out: dict[tuple[str, int], tuple[str, ...]] = {}
     at = 0
-    for controller, seed in keys:
-        if protocol.nominal_first and seed == 0:
-            out[controller, seed] = ()
-            continue
-        part, at = res[at : at + len(factors)], at + len(factors)
-        out[controller, seed] = tuple(
-            f for f, r in zip(factors, part, strict=True) if not r.metrics.fell
-        )
+    for key, tried in asked:
+        part, at = res[at : at + len(tried)], at + len(tried)
+        out[key] = tuple(f for f, r in zip(tried, part, strict=True) if not r.metrics.fell)
     return out

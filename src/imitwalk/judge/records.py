@@ -91,6 +91,13 @@ class ControllerVerdict:
     falls_saved_by_factor: dict[str, int] | None = None
     falls_no_single_factor: int | None = None
 
+    def explained(self) -> str | None:
+        """The falls explained, as one line (``None``: not asked, or none fell)."""
+        if self.falls_saved_by_factor is None or not self.falls:
+            return None
+        saved = ", ".join(f"{f} {n}" for f, n in self.falls_saved_by_factor.items() if n)
+        return f"{saved or 'none'}; by no single factor: {self.falls_no_single_factor}"
+
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
         out = asdict(self)

@@ -53,15 +53,11 @@ def protocol_table(result: ProtocolVerdict) -> str:
 
 def _explained(sides) -> str:
     """The falls explained (``evaluate --explain-falls``), one line per controller."""
-    lines = []
-    for name, s in sides.items():
-        if s.falls_saved_by_factor is None or not s.falls:
-            continue
-        saved = ", ".join(f"{html.escape(f)} {n}" for f, n in s.falls_saved_by_factor.items() if n)
-        lines.append(
-            f"<li>{html.escape(name)}: {saved or 'none'}; by no single factor: "
-            f"{s.falls_no_single_factor}</li>"
-        )
+    lines = [
+        f"<li>{html.escape(name)}: {html.escape(line)}</li>"
+        for name, s in sides.items()
+        if (line := s.explained()) is not None
+    ]
     if not lines:
         return ""
     head = "<p>Falls saved by setting one factor alone back to nominal:</p>"
