@@ -37,6 +37,7 @@ TICK = [
     "trials.pitch=0,0.1",
     "trials.roll=0,0.1",
     "trials.heading=0,0.3",
+    "trials.torso=0,-0.3",
     "workers=1",
 ]
 

@@ -33,7 +33,7 @@ def test_a_channel_moves_its_joints_by_its_value_and_nothing_else(robot, channel
 
 
 def test_both_legs_channels_are_the_sum_of_one_legs():
-    for both in ("ankle_pitch", "ankle_roll", "hip_roll"):
+    for both in ("ankle_pitch", "ankle_roll", "hip_roll", "hip_pitch"):
         assert set(CHANNELS[both]) == set(CHANNELS[f"l_{both}"]) | set(CHANNELS[f"r_{both}"])
 
 

@@ -39,6 +39,16 @@ def test_eval_draws_the_robots_figures_were_judged_on_before(robot):
     assert load_protocol("bullet").draw(7, robot).options == p.draw(7, robot).options
 
 
+def test_servo_draws_evals_robots_with_hards_servo_spread(robot):
+    servo, ev = load_protocol("servo"), load_protocol("eval")
+    assert servo.factors["servo"]["spread"] == load_protocol("hard").factors["servo"]["spread"]
+    for seed in range(8):
+        o, e = servo.draw(seed, robot).options, ev.draw(seed, robot).options
+        same = ("friction", "mass_jitter", "init_twist")
+        assert [getattr(o, k) for k in same] == [getattr(e, k) for k in same]
+        assert o.kp_jitter == (0.2 if seed else e.kp_jitter)
+
+
 def test_hard_draws_cover_their_ranges(robot):
     p = load_protocol("hard")
     draws = [p.draw(s, robot, seconds=30.0) for s in range(40)]

@@ -17,6 +17,7 @@ OUT_OF_RANGE = [
     ("trials.pitch", "0,0.6", "-0.5..0.5"),
     ("trials.roll", "-0.7", "-0.5..0.5"),
     ("trials.heading", "0,2.5", "-2..2"),
+    ("trials.torso", "0,-1.5", "-1..1"),
     ("trials.box", "0.6", "0.001..0.5"),
     ("trials.box", "0", "0.001..0.5"),
     ("trials.robots", "0", "1..1000"),
@@ -66,6 +67,8 @@ def test_names_are_checked_with_the_valid_ones_listed():
         TickLearnConfig(engine="physx")
     with pytest.raises(ConfigError, match=r"unknown protocol 'harder'; valid: bullet, eval, hard"):
         TickLearnConfig(train_protocol="harder")
+    with pytest.raises(ConfigError, match=r"unknown protocol 'srvo'; valid: .*servo"):
+        apply_overrides(TickLearnConfig(), ["trials.torso_protocol=srvo"])
     with pytest.raises(ConfigError, match=r"unknown setting 'lqr\.gain'; valid: .*lqr\.trust"):
         apply_overrides(TickLearnConfig(), ["lqr.gain=1"])
 

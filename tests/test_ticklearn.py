@@ -58,7 +58,7 @@ def test_a_tiny_run_writes_its_folder(tick_run):
     assert rd.read_json("config.json")["learner"] == m["learner"] == "tick"
     assert rd.read_json("checkpoint.json")["stage"] == "done"
     # the trial-picked gains, each one of its candidates, and the kept fraction of the law
-    assert set(m["feedback_gains"]) == {name for name, *_ in TRIAL_GAINS}
+    assert set(m["feedback_gains"]) == {g.name for g in TRIAL_GAINS}
     for name, value in m["feedback_gains"].items():
         assert value in getattr(cfg.trials, name)
     assert m["trust"] in cfg.lqr.trust
@@ -72,9 +72,10 @@ def test_a_tiny_run_writes_its_folder(tick_run):
     for entry, name in zip(log, ("feedforward", "wait"), strict=False):
         assert (entry["gain"], entry["kept"]) == (name, m["reference_settings"][name])
         assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
-    for entry, (name, channel, feature, _) in zip(log[2:], TRIAL_GAINS, strict=False):
-        assert (entry["gain"], entry["channel"], entry["feature"]) == (name, channel, feature)
-        assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
+    for entry, g in zip(log[2:], TRIAL_GAINS, strict=False):
+        assert (entry["gain"], entry["channel"], entry["feature"]) == (g.name, g.channel, g.feature)
+        assert entry["protocol"] == (getattr(cfg.trials, g.protocol) if g.protocol else "eval")
+        assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, g.name))
         kept = next(r for r in entry["table"] if r["value"] == entry["kept"])
         assert kept["falls"] == min(r["falls"] for r in entry["table"])  # fewest falls first
         assert kept["robots"] == cfg.trials.robots  # the kept law walked every trial robot
@@ -108,20 +109,31 @@ def test_the_controllers_a_run_builds(tick_run):
     m = RunDir(tick_run).read_json("metrics.json")
     assert set(laws) == {"learned", "feedback", "fixed"}
     (base,) = laws["feedback"]
-    for name, channel, feature, _ in TRIAL_GAINS:
-        assert base.gain(channel, feature) == m["feedback_gains"][name]
+    for g in TRIAL_GAINS:
+        assert base.gain(g.channel, g.feature) == m["feedback_gains"][g.name]
     assert laws["learned"][0] is base  # the model-based law acts on top of the trial-picked one
     learned = FeedbackLaw.from_arrays(RunDir(tick_run).read_arrays("learned.npz"), "")
     if m["trust"]:
         np.testing.assert_allclose(laws["learned"][1].gains, m["trust"] * learned.gains)
     else:
         assert len(laws["learned"]) == 1
+    # the torso's pitch is measured against the nominal robot's, per loop tick; nothing else
+    rd = RunDir(tick_run)
+    profile = rd.read_arrays("profiles.npz")["pitch"]
+    n = Reference.load(rd.file("reference.npz")).loops.shape[1]
+    assert profile.shape == (n,) and np.isfinite(profile).all() and np.ptp(profile) > 0
+    assert rd.read_json("checkpoint.json")["profiles"]["pitch"] == profile.tolist()
+    pitch = base.features.index("pitch")
+    np.testing.assert_array_equal(base.nominal[:, pitch], profile)
+    assert not np.delete(base.nominal, pitch, axis=1).any()
+    walks = [k for k in rd.read_json("checkpoint.json")["tried"] if k.startswith("nominal robot")]
+    assert walks == ["nominal robot: pitch profile@6s"]
     (fixed,) = laws["fixed"]
     assert (fixed.channels, fixed.features) == (("ankle_pitch",), ("gyro_y",))
     assert fixed.gain("ankle_pitch", "gyro_y") == 0.05
 
 
-@pytest.mark.parametrize(("line", "stage"), [(3, "trials"), (10, "trust")])
+@pytest.mark.parametrize(("line", "stage"), [(3, "trials"), (7, "trials"), (12, "trust")])
 def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp_path, line, stage):
     ref = Reference.load(tick_reference)
     cut, resumed = _cut_and_resume(ref, robot, tmp_path / "cut", line)
@@ -136,7 +148,7 @@ def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp
 def cut_in_schedule(tick_reference, robot, tmp_path_factory):
     """A run interrupted in its second schedule iteration, resumed."""
     out = tmp_path_factory.mktemp("cut") / "run"
-    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 7)
+    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 9)
     assert cut["stage"] == "schedule" and cut["iteration"] == 1
     return out, resumed
 
@@ -183,7 +195,7 @@ def test_a_run_without_the_model_based_law_keeps_the_trial_picked_one(
     res = json.loads(capsys.readouterr().out)
     assert res["variant"] == "extended" and res["run_dir"] == str(out)
     assert res["iterations"] == 0 and res["trust"] is None
-    assert set(res["feedback_gains"]) == {"pitch", "roll", "heading"}
+    assert set(res["feedback_gains"]) == {"pitch", "roll", "heading", "torso"}
     rd = RunDir(out)
     assert not rd.exists("learned.npz") and rd.read_json("checkpoint.json")["stage"] == "done"
     laws = load_laws(out)

@@ -20,12 +20,13 @@ from imitwalk.errors import ConfigError, unknown_name
 __all__ = ["CHANNELS", "FEATURES", "PHASED", "channel_matrix", "check_names", "turn_pattern"]
 
 #: Channel → the joint roles it moves, each by the channel's value (radians).
-#: ``ankle_pitch`` / ``ankle_roll`` / ``hip_yaw`` move both legs' joints together; the
-#: ``l_`` / ``r_`` channels one leg's.
+#: ``ankle_pitch`` / ``ankle_roll`` / ``hip_yaw`` / ``hip_pitch`` move both legs' joints
+#: together; the ``l_`` / ``r_`` channels one leg's.
 CHANNELS: dict[str, tuple[str, ...]] = {
     "ankle_pitch": ("l_ankle_pitch", "r_ankle_pitch"),
     "ankle_roll": ("l_ankle_roll", "r_ankle_roll"),
     "hip_yaw": ("l_hip_yaw", "r_hip_yaw"),
+    "hip_pitch": ("l_hip_pitch", "r_hip_pitch"),
     "turn": ("l_hip_yaw", "r_hip_yaw"),
     "hip_roll": ("l_hip_roll", "r_hip_roll"),
     "l_ankle_pitch": ("l_ankle_pitch",),

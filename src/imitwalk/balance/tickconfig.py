@@ -51,6 +51,12 @@ class TrialConfig:
         roll: candidate gains gyro_x → ankle_roll [rad per rad/s].
         heading: candidate gains heading → turn [rad of turn per step per rad of heading
             error]; a negative gain steers back.
+        torso: candidate gains pitch → hip_pitch [rad per rad]: the torso's measured
+            pitch less the nominal robot's at that loop tick, fed to both hip pitches; a
+            negative gain leans a torso that pitches forward back.
+        torso_protocol: the protocol the torso gain's training robots are drawn from (a
+            shipped name or a ``.json``): on ``eval``'s, trials of a few robots see no
+            falls under any candidate (docs/RESULTS.md).
         yaw_limit_deg: the mean |yaw drift| a walk of ``heading_seconds`` may keep [deg]
             (the acceptance's 10° in 30 s).
         box: each channel's limit [rad].
@@ -66,6 +72,8 @@ class TrialConfig:
     pitch: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2)
     roll: tuple[float, ...] = (0.0, 0.05, 0.1)
     heading: tuple[float, ...] = (0.0, -0.25, -0.5)
+    torso: tuple[float, ...] = (0.0, -0.15, -0.3)
+    torso_protocol: str = "servo"
     yaw_limit_deg: float = 10.0
     box: float = 0.15
     robots: int = 14
@@ -79,6 +87,8 @@ class TrialConfig:
         _range("trials.pitch", self.pitch, -0.5, 0.5)
         _range("trials.roll", self.roll, -0.5, 0.5)
         _range("trials.heading", self.heading, -2.0, 2.0)
+        _range("trials.torso", self.torso, -1.0, 1.0)
+        load_protocol(self.torso_protocol)  # a one-line error if unknown
         _range("trials.yaw_limit_deg", (self.yaw_limit_deg,), 0.0, 180.0)
         _range("trials.box", (self.box,), 0.001, 0.5)
         _range("trials.robots", (self.robots,), 1, 1000)

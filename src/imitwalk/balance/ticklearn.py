@@ -7,8 +7,9 @@ and ends where an uninterrupted one would:
    the fraction of the servo feedforward added to it
    (:mod:`imitwalk.retarget.feedforward`), then the load share at which its clock waits
    before a lift-off (:class:`~imitwalk.balance.feedback.TickPolicy`); then the
-   feedback law gyro_y → ankle pitch, gyro_x → ankle
-   roll, heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
+   feedback law gyro_y → ankle pitch, gyro_x → ankle roll, the torso's pitch less the
+   nominal robot's → both hip pitches (on training robots with a wider servo spread),
+   heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
    chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
    many short walks of training robots: the baseline the learned law starts from.
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
@@ -73,7 +74,7 @@ def _learned_law(lr: Learner, episodes: list[Episode]):
 def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
     """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
     cfg = lr.cfg
-    base = feedback_law(cfg, state.gains)
+    base = feedback_law(cfg, state.gains, state.profiles)
     learned, model = load_learned(lr.rd), None
     if data and state.scale_index < len(lr.scales):  # resumed: the model of the last iteration
         last = log[-1]["scale"] if log and log[-1].get("stage") == "schedule" else None
@@ -129,7 +130,7 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
     if learned is None:
         state.trust, state.stage = 0.0, "done"
         return
-    base = feedback_law(cfg, state.gains)
+    base = feedback_law(cfg, state.gains, state.profiles)
     table: list[tuple[float, Trial]] = []
     for frac in sorted(cfg.lqr.trust, reverse=True):
         laws = [base] if frac == 0 else [base, replace(learned, gains=learned.gains * frac)]

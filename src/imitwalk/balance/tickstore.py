@@ -3,7 +3,7 @@ episodes, and the controllers a finished run builds (:func:`load_laws`)."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -15,30 +15,65 @@ from imitwalk.runs import RunDir
 
 __all__ = [
     "TRIAL_GAINS",
+    "TrialGain",
     "feedback_law",
     "load_laws",
     "load_learned",
+    "load_profiles",
     "save_learned",
+    "save_profiles",
     "stack_episodes",
     "unstack_episodes",
 ]
 
-#: The trial-picked gains, in the order they are tried: (setting, channel, feature,
-#: whether the walk's heading drift limits it: :meth:`Trial.rank`).
+
+@dataclass(frozen=True)
+class TrialGain:
+    """One trial-picked gain: ``feature`` → ``channel``, its candidates the setting
+    ``name`` of :class:`~imitwalk.balance.tickconfig.TrialConfig`.
+
+    Attributes:
+        steers: the walk's heading drift limits it (:meth:`~imitwalk.balance.tickrun.Trial.rank`).
+        profiled: its feature is measured against the nominal robot's own profile per
+            loop tick (walked once, before its trials), not against 0.
+        protocol: the :class:`~imitwalk.balance.tickconfig.TrialConfig` setting naming
+            the protocol its training robots come from (``None``: the learner's
+            ``train_protocol``).
+    """
+
+    name: str
+    channel: str
+    feature: str
+    steers: bool = False
+    profiled: bool = False
+    protocol: str | None = None
+
+
+#: The trial-picked gains, in the order they are tried. The torso's pitch, measured,
+#: is held to the nominal robot's through both hip pitches: a servo spread along a
+#: leg's pitch chain changes how much the torso leans (docs/RESULTS.md). The heading is
+#: last: how far a walk drifts depends on every balance gain.
 TRIAL_GAINS = (
-    ("pitch", "ankle_pitch", "gyro_y", False),
-    ("roll", "ankle_roll", "gyro_x", False),
-    ("heading", "turn", "heading", True),
+    TrialGain("pitch", "ankle_pitch", "gyro_y"),
+    TrialGain("roll", "ankle_roll", "gyro_x"),
+    TrialGain("torso", "hip_pitch", "pitch", profiled=True, protocol="torso_protocol"),
+    TrialGain("heading", "turn", "heading", steers=True),
 )
 
 
-def feedback_law(cfg: TickLearnConfig, gains: dict) -> FeedbackLaw:
-    """The trial-picked law with ``gains`` by setting name (a missing one is 0)."""
-    channels = tuple(c for _, c, _, _ in TRIAL_GAINS)
-    features = tuple(dict.fromkeys(f for _, _, f, _ in TRIAL_GAINS))
-    law = FeedbackLaw.zero(channels, features, cfg.trials.box)
-    for name, channel, feature, _ in TRIAL_GAINS:
-        law = law.with_gain(channel, feature, float(gains.get(name, 0.0)))
+def feedback_law(cfg: TickLearnConfig, gains: dict, profiles: dict | None = None) -> FeedbackLaw:
+    """The trial-picked law with ``gains`` by setting name (a missing one is 0) and the
+    nominal ``profiles`` by feature, each ``(N,)`` per loop tick (a missing one is 0)."""
+    channels = tuple(g.channel for g in TRIAL_GAINS)
+    features = tuple(dict.fromkeys(g.feature for g in TRIAL_GAINS))
+    profiles = profiles or {}
+    n = max((len(p) for p in profiles.values()), default=1)
+    nominal = np.zeros((n, len(features)))
+    for feature, profile in profiles.items():
+        nominal[:, features.index(feature)] = profile
+    law = replace(FeedbackLaw.zero(channels, features, cfg.trials.box), nominal=nominal)
+    for g in TRIAL_GAINS:
+        law = law.with_gain(g.channel, g.feature, float(gains.get(g.name, 0.0)))
     return law
 
 
@@ -67,6 +102,18 @@ def save_learned(rd: RunDir, law: FeedbackLaw | None) -> None:
         rd.write_arrays("learned.npz", law.to_arrays(""))
 
 
+def save_profiles(rd: RunDir, profiles: dict) -> None:
+    """The trial-picked law's nominal profiles, by feature (``profiles.npz``)."""
+    if profiles:
+        arrays = {f: np.asarray(p, dtype=float) for f, p in profiles.items()}
+        rd.write_arrays("profiles.npz", arrays)
+
+
+def load_profiles(rd: RunDir) -> dict[str, np.ndarray]:
+    """Inverse of :func:`save_profiles` (none for a run without one)."""
+    return dict(rd.read_arrays("profiles.npz")) if rd.exists("profiles.npz") else {}
+
+
 def load_learned(rd: RunDir) -> FeedbackLaw | None:
     if not rd.exists("learned.npz"):
         return None
@@ -82,7 +129,7 @@ def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
     cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
     if metrics.feedback_gains is None:
         raise RunError(f"{rd.file('metrics.json')} has no feedback_gains: not a per-tick run")
-    base = feedback_law(cfg, metrics.feedback_gains)
+    base = feedback_law(cfg, metrics.feedback_gains, load_profiles(rd))
     fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
         "ankle_pitch", "gyro_y", 0.05
     )

@@ -4,7 +4,8 @@
 Trials pick, one setting at a time and each from its candidates, at the top scale, on
 many short walks of training robots (:class:`~imitwalk.balance.tickrun.Trial`): first,
 with no feedback, how the reference is played (:data:`REFERENCE_SETTINGS`), then the
-feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`).
+feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`). A gain whose
+feature is held to the nominal robot's profile first walks the nominal robot once.
 """
 
 from __future__ import annotations
@@ -12,10 +13,12 @@ from __future__ import annotations
 import time
 from dataclasses import asdict, dataclass, field, replace
 
+from imitwalk.balance.feedback import Episode
 from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.tickmodel import nominal_profile
 from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode
-from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, stack_episodes
-from imitwalk.judge.protocol import load_protocol
+from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, save_profiles, stack_episodes
+from imitwalk.judge.protocol import RobotDraw, load_protocol
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
@@ -30,6 +33,7 @@ __all__ = [
     "checkpoint",
     "gains_key",
     "most_falls",
+    "profile",
     "say_table",
     "trial",
     "trials",
@@ -48,7 +52,8 @@ class TickProgress:
         stage: ``"trials"``, ``"schedule"``, ``"trust"`` or ``"done"``.
         settings: how the reference is played, by name (:data:`REFERENCE_SETTINGS`),
             as the trials picked them so far; gains: the trial-picked gains so far, by
-            setting name; trial: the next gain.
+            setting name; trial: the next gain; profiles: the nominal robot's profile
+            of each profiled feature, per loop tick (:func:`profile`).
         scale_index, iteration: where the schedule is; passed: scales passed.
         trust: the fraction of the learned law kept (``None`` until decided).
         tried: every candidate's trial results so far, by key (run once each).
@@ -59,6 +64,7 @@ class TickProgress:
     settings: dict = field(default_factory=dict)
     gains: dict = field(default_factory=dict)
     trial: int = 0
+    profiles: dict = field(default_factory=dict)
     scale_index: int = 0
     iteration: int = 0
     passed: list = field(default_factory=list)
@@ -78,11 +84,11 @@ class Learner:
         self.scales = cfg.scales()
         self.ref_path = str(rd.file("reference.npz"))
 
-    def robots(self, n: int, first: int, seconds: float):
-        return [
-            self.protocol.draw(first + j, self.robot, self.ref.sim_options(), seconds)
-            for j in range(n)
-        ]
+    def robots(self, n: int, first: int, seconds: float, protocol: str | None = None):
+        """``n`` training robots from the ``first``-th on, drawn from ``protocol`` (a
+        name; ``None``: the learner's ``train_protocol``)."""
+        p = self.protocol if protocol is None else load_protocol(protocol)
+        return [p.draw(first + j, self.robot, self.ref.sim_options(), seconds) for j in range(n)]
 
     def run(self, state, scale, laws, draws, seconds, explore=0.0, rng=0, settings=None,
             first=0, stop=None):  # fmt: skip
@@ -114,10 +120,12 @@ class Learner:
         return out
 
 
-def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most=None) -> Trial:
+def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most=None,
+          protocol=None) -> Trial:  # fmt: skip
     """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
-    reference played with ``settings`` (default: the ones kept), run once per key (kept
-    in the checkpoint, so that a resumed run neither repeats nor re-counts them).
+    reference played with ``settings`` (default: the ones kept), on training robots from
+    ``protocol`` (``None``: ``train_protocol``), run once per key (kept in the
+    checkpoint, so that a resumed run neither repeats nor re-counts them).
 
     With ``most`` (the most falls this candidate may have and still be kept,
     :func:`most_falls`), its walks stop once it has fallen more often, and with a
@@ -132,12 +140,12 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
     settings = state.settings if settings is None else settings
     key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
-    key = f"{key}@{n}x{seconds:g}s"
+    key = f"{key}@{n}x{seconds:g}s" + ("" if protocol is None else f" [{protocol}]")
     done = [TickResult(**r) for r in state.tried.get(key, [])]
     limit = n if most is None else most
     fell = sum(r.fell for r in done)
     if len(done) < n and fell <= limit:
-        draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds)
+        draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds, protocol)
         stop = None if most is None else (lambda out: fell + sum(r.fell for r in out) > limit)
         res = lr.run(state, lr.scales[-1], laws, draws, seconds, settings=settings,
                      first=len(done), stop=stop)  # fmt: skip
@@ -171,7 +179,7 @@ def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) ->
 
 def gains_key(gains: dict) -> str:
     """The trials' key of a law with ``gains`` by setting name (a missing one is 0)."""
-    return ",".join(f"{k}={gains.get(k, 0.0):g}" for k, *_ in TRIAL_GAINS)
+    return ",".join(f"{g.name}={gains.get(g.name, 0.0):g}" for g in TRIAL_GAINS)
 
 
 def say_table(lr: Learner, head: str, table) -> None:
@@ -204,29 +212,57 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
         checkpoint(lr, state, log)
 
 
+def profile(lr: Learner, state: TickProgress, feature: str) -> None:
+    """The nominal robot's ``feature`` per loop tick (into ``state.profiles``), under the
+    law the trials kept so far: one walk of ``trials.seconds`` at the top scale, its
+    start-up and, if it fell, its last half second left out (its start-up too if nothing
+    else is left)."""
+    cfg, ref = lr.cfg, lr.ref
+    key = f"nominal robot: {feature} profile@{cfg.trials.seconds:g}s"
+    laws = [feedback_law(cfg, state.gains, state.profiles)]
+    nominal = RobotDraw(0, ref.sim_options())
+    (res,) = lr.run(state, lr.scales[-1], laws, [nominal], cfg.trials.seconds)
+    ep = res.episode
+    assert ep is not None  # walks record their ticks
+    end = len(ep.phase) - (round(0.5 / ref.dt) if res.fell else 0)
+    start = ref.starts.shape[1] if end > ref.starts.shape[1] else 0
+    cut = Episode(ep.phase[start:end], ep.features[start:end], ep.actions[start:end])
+    p = nominal_profile([cut], (feature,), ref.loops.shape[1])[:, 0]
+    state.profiles[feature] = p.tolist()
+    state.tried[key] = [asdict(replace(res, episode=None))]
+    fell = f", fell at {res.fall_time_s:.1f} s" if res.fell else ""
+    lr.say(f"trials: the nominal robot's {feature} {p.min():+.3f}..{p.max():+.3f}{fell}")
+
+
 def trials(lr: Learner, state: TickProgress, log: list) -> None:
     """Stage 1: how the reference is played, then one gain at a time, each from its
     candidates, at the top scale."""
     cfg = lr.cfg
     _reference_settings(lr, state, log)
     while state.trial < len(TRIAL_GAINS):
-        name, channel, feature, steers = TRIAL_GAINS[state.trial]
-        limit = cfg.trials.yaw_limit_deg if steers else None
+        g = TRIAL_GAINS[state.trial]
+        if g.profiled and g.feature not in state.profiles:
+            profile(lr, state, g.feature)
+            checkpoint(lr, state, log)
+        limit = cfg.trials.yaw_limit_deg if g.steers else None
+        protocol = getattr(cfg.trials, g.protocol) if g.protocol else None
         table: list[tuple[float, Trial]] = []
-        for value in getattr(cfg.trials, name):
-            gains = {**state.gains, name: float(value)}
-            laws = [feedback_law(cfg, gains)]
+        for value in getattr(cfg.trials, g.name):
+            gains = {**state.gains, g.name: float(value)}
+            laws = [feedback_law(cfg, gains, state.profiles)]
             most = most_falls(table, value, limit)
-            run = trial(lr, state, gains_key(gains), laws, steers, most=most)
+            run = trial(lr, state, gains_key(gains), laws, g.steers, most=most, protocol=protocol)
             table.append((float(value), run))
-        state.gains[name] = kept = best(table, limit)[0]
+        state.gains[g.name] = kept = best(table, limit)[0]
         log.append(
-            {"stage": "trials", "gain": name, "channel": channel, "feature": feature,
-             "kept": kept, "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
+            {"stage": "trials", "gain": g.name, "channel": g.channel, "feature": g.feature,
+             "kept": kept, "protocol": protocol or cfg.train_protocol,
+             "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
         )  # fmt: skip
-        say_table(lr, f"trials: {feature} -> {channel} = {kept:g}", table)
+        say_table(lr, f"trials: {g.feature} -> {g.channel} = {kept:g}", table)
         state.trial += 1
         checkpoint(lr, state, log)
+    save_profiles(lr.rd, state.profiles)
     state.stage = "schedule" if cfg.lqr.enabled else "done"
 
 

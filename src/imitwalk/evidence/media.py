@@ -80,7 +80,7 @@ def summary_phrase(metrics: LearnSummary) -> str:
     if gains is None:
         return f"{metrics.iterations} iterations of the paper's learner"
     names = {"pitch": "gyro_y → ankle pitch", "roll": "gyro_x → ankle roll",
-             "heading": "heading → turn"}  # fmt: skip
+             "torso": "torso pitch → hip pitch", "heading": "heading → turn"}  # fmt: skip
     kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
     trust = metrics.trust
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"
