@@ -94,7 +94,7 @@ def main() -> None:
     if args.source.endswith(".npz"):
         path, ref, scale = args.source, Reference.load(args.source), args.scale
         gains = dict(x.split("=") for x in args.gains.split(",")) if args.gains else None
-        valid = [name for name, *_ in TRIAL_GAINS]
+        valid = [g.name for g in TRIAL_GAINS if not g.profiled]  # no nominal walk here
         if gains and set(gains) - set(valid):
             ap.error(f"--gains names one of {', '.join(valid)}; got {', '.join(gains)}")
         laws = (feedback_law(TickLearnConfig(), gains),) if gains else ()  # the learner's law
