@@ -83,7 +83,7 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
     while state.scale_index < len(lr.scales):
         scale = lr.scales[state.scale_index]
         explore = cfg.lqr.explore if state.iteration == 0 else 0.0
-        n = len(log)
+        n = sum(e["stage"] == "schedule" for e in log)  # not moved by how many trials came first
         draws = lr.robots(cfg.robots, TRAIN_SEED_BASE + 1 + cfg.robots * n, cfg.seconds)
         laws = [base] if learned is None else [base, learned]
         if learned is None:  # the first iteration records the trial-picked law's channels
