@@ -8,7 +8,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from imitwalk.balance import ticktrials
@@ -53,7 +53,8 @@ def _learner(ticks: int, fell: bool, monkeypatch) -> Learner:
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.integers(START + 2 * LOOP, START + 6 * LOOP), st.booleans())
+@given(st.integers(START + LOOP + round(0.5 / DT), START + 6 * LOOP), st.booleans())
+@example(START + LOOP + round(0.5 / DT), True)  # a fall just after one whole loop
 def test_the_profile_is_the_loops_own_pitch(ticks, fell):
     state = TickProgress()
     with pytest.MonkeyPatch.context() as mp:
