@@ -19,9 +19,7 @@ __all__ = [
     "feedback_law",
     "load_laws",
     "load_learned",
-    "load_profiles",
     "save_learned",
-    "save_profiles",
     "stack_episodes",
     "unstack_episodes",
 ]
@@ -102,18 +100,6 @@ def save_learned(rd: RunDir, law: FeedbackLaw | None) -> None:
         rd.write_arrays("learned.npz", law.to_arrays(""))
 
 
-def save_profiles(rd: RunDir, profiles: dict) -> None:
-    """The trial-picked law's nominal profiles, by feature (``profiles.npz``)."""
-    if profiles:
-        arrays = {f: np.asarray(p, dtype=float) for f, p in profiles.items()}
-        rd.write_arrays("profiles.npz", arrays)
-
-
-def load_profiles(rd: RunDir) -> dict[str, np.ndarray]:
-    """Inverse of :func:`save_profiles` (none for a run without one)."""
-    return dict(rd.read_arrays("profiles.npz")) if rd.exists("profiles.npz") else {}
-
-
 def load_learned(rd: RunDir) -> FeedbackLaw | None:
     if not rd.exists("learned.npz"):
         return None
@@ -129,7 +115,8 @@ def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
     cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
     if metrics.feedback_gains is None:
         raise RunError(f"{rd.file('metrics.json')} has no feedback_gains: not a per-tick run")
-    base = feedback_law(cfg, metrics.feedback_gains, load_profiles(rd))
+    profiles = rd.read_json("checkpoint.json").get("profiles", {})  # none before 2026-12-04
+    base = feedback_law(cfg, metrics.feedback_gains, profiles)
     fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
         "ankle_pitch", "gyro_y", 0.05
     )

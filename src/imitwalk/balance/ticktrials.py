@@ -17,7 +17,7 @@ from imitwalk.balance.feedback import Episode
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import nominal_profile
 from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode
-from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, save_profiles, stack_episodes
+from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, stack_episodes
 from imitwalk.judge.protocol import RobotDraw, load_protocol
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
@@ -262,7 +262,6 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         say_table(lr, f"trials: {g.feature} -> {g.channel} = {kept:g}", table)
         state.trial += 1
         checkpoint(lr, state, log)
-    save_profiles(lr.rd, state.profiles)
     state.stage = "schedule" if cfg.lqr.enabled else "done"
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from imitwalk.balance.tickstore import TRIAL_GAINS
 from imitwalk.evidence import curves, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.judge.replay import LoadedRun
@@ -79,8 +80,7 @@ def summary_phrase(metrics: LearnSummary) -> str:
     gains = metrics.feedback_gains
     if gains is None:
         return f"{metrics.iterations} iterations of the paper's learner"
-    names = {"pitch": "gyro_y → ankle pitch", "roll": "gyro_x → ankle roll",
-             "torso": "torso pitch → hip pitch", "heading": "heading → turn"}  # fmt: skip
+    names = {g.name: f"{g.feature} → {g.channel.replace('_', ' ')}" for g in TRIAL_GAINS}
     kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
     trust = metrics.trust
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"

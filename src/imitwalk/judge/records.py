@@ -110,15 +110,15 @@ class ControllerVerdict:
         """The record :meth:`to_dict` wrote."""
         rows = tuple(_row(r) for r in d["per_seed"])
         lo, hi = d["survival_ci95"]
-        own: dict[str, Any] = {
-            f.name: d[f.name] if f.name in d or not _optional(f) else None for f in fields(cls)
-        }
+        own = _own(cls, d)
         return cls(**{**own, "survival_ci95": (float(lo), float(hi)), "per_seed": rows})
 
 
-def _optional(f) -> bool:
-    """A field later releases added, with a default (files written before lack it)."""
-    return f.default is None
+def _own(cls, d: dict) -> dict[str, Any]:
+    """``cls``'s fields as ``d`` holds them; a field later releases added with a default
+    of ``None`` is ``None`` where ``d``, written before, lacks it."""
+    return {f.name: d[f.name] if f.name in d or f.default is not None else None
+            for f in fields(cls)}  # fmt: skip
 
 
 def _row_dict(r: SeedRow) -> dict:
@@ -128,9 +128,7 @@ def _row_dict(r: SeedRow) -> dict:
 
 
 def _row(r: dict) -> SeedRow:
-    own: dict[str, Any] = {
-        f.name: r[f.name] if f.name in r or not _optional(f) else None for f in fields(SeedRow)
-    }
+    own = _own(SeedRow, r)
     if own["saved_by"] is not None:
         own["saved_by"] = tuple(own["saved_by"])
     return SeedRow(**own)
