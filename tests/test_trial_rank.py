@@ -51,6 +51,23 @@ def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit()
     assert pick([(0.0, _walks(0, yaw=19.0)), (-0.5, _walks(1, yaw=1.0))]) == 0.0  # falls first
 
 
+def test_a_drift_just_under_the_limit_must_hold_by_one_standard_error():
+    limit = 10.0
+
+    def spread(yaws: tuple[float, ...]) -> Trial:
+        return Trial([TickResult(j, False, None, 30.0, 1.0, y, 1.0) for j, y in enumerate(yaws)])
+
+    pick = lambda t: min(t, key=lambda row: row[1].rank(row[0], limit))[0]  # noqa: E731
+    wide = spread((1.0, 2.0, 3.0, 10.0, 15.0, 17.0))  # mean 8.0, standard error 2.9
+    narrow = spread((7.0, 8.0, 8.0, 8.0, 8.0, 9.0))  # mean 8.0, standard error 0.3
+    steered = spread((4.0, 5.0, 5.0, 5.0, 5.0, 6.0))
+    assert pick([(0.0, wide), (-0.25, steered)]) == -0.25
+    assert pick([(0.0, narrow), (-0.25, steered)]) == 0.0
+    # the sign of a drift does not count, only its size
+    signed = spread((-1.0, 2.0, -3.0, 10.0, -15.0, 17.0))
+    assert wide.summary().abs_yaw_se_deg == signed.summary().abs_yaw_se_deg
+
+
 def test_where_every_robot_fell_the_longest_walked_wins():
     def fell_at(t: float) -> Trial:
         return Trial([TickResult(j, True, t, t, 0.1, 1.0, float("inf")) for j in range(4)])

@@ -35,11 +35,11 @@ def _range(name: str, values, lo: float, hi: float) -> None:
 class TrialConfig:
     """The trial-picked feedback law: each gain chosen in turn from its candidates by
     trials on training robots (:class:`imitwalk.balance.ticklearn.Trial`): the fewest falls,
-    then, for the heading gain, the least mean |yaw| beyond ``yaw_limit_deg``, then the
-    smallest gain (the least feedback that does as well: the one-standard-error rule of
-    model selection, at a standard error of zero falls). The signs searched follow the
-    joints' conventions (x forward, y left, z up): a positive ankle offset on a positive
-    gyro rate pushes back against the fall.
+    then, for the heading gain, the least mean |yaw| (plus one standard error) beyond
+    ``yaw_limit_deg``, then the smallest gain (the least feedback that does as well: the
+    one-standard-error rule of model selection, at a standard error of zero falls). The
+    signs searched follow the joints' conventions (x forward, y left, z up): a positive
+    ankle offset on a positive gyro rate pushes back against the fall.
 
     Attributes:
         feedforward: candidate fractions of the servo feedforward added to the reference
@@ -58,7 +58,8 @@ class TrialConfig:
             shipped name or a ``.json``): on ``eval``'s, trials of a few robots see no
             falls under any candidate (docs/RESULTS.md).
         yaw_limit_deg: the mean |yaw drift| a walk of ``heading_seconds`` may keep [deg]
-            (the acceptance's 10° in 30 s).
+            (the acceptance's 10° in 30 s), with one standard error of the trial's mean
+            to spare.
         box: each channel's limit [rad].
         robots, seconds: training robots per balance candidate and simulated time each
             [s] (many short walks: falls come from rare robots and pushes, not from time).

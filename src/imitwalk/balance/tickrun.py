@@ -119,8 +119,8 @@ def run_tick_episode(job: TickJob) -> TickResult:
 @dataclass(frozen=True)
 class WalkSummary:
     """Some walks in a few numbers: falls, robots, mean Γ of the robots that stayed up
-    [rad²/s²] (``inf`` if none did), seconds walked in all [s], mean forward distance [m]
-    and mean |yaw drift| [deg]."""
+    [rad²/s²] (``inf`` if none did), seconds walked in all [s], mean forward distance [m],
+    mean |yaw drift| [deg] and that mean's standard error [deg] (0 below two walks)."""
 
     falls: int
     robots: int
@@ -128,6 +128,7 @@ class WalkSummary:
     walked_s: float
     distance_m: float
     abs_yaw_deg: float
+    abs_yaw_se_deg: float = 0.0
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary (a row of the learning log's tables)."""
@@ -138,13 +139,16 @@ def summarize(results: list[TickResult]) -> WalkSummary:
     """:class:`WalkSummary` of ``results`` (over no walks: no falls, the means 0)."""
     up = [r for r in results if not r.fell]
     mean = lambda xs: float(np.mean(xs)) if xs else 0.0  # noqa: E731  (no walks: 0)
+    yaws = [abs(r.yaw_drift_deg) for r in results]
+    se = float(np.std(yaws, ddof=1) / np.sqrt(len(yaws))) if len(yaws) > 1 else 0.0
     return WalkSummary(
         falls=int(sum(r.fell for r in results)),
         robots=len(results),
         cost=mean([r.cost for r in up]) if up else float("inf"),
         walked_s=float(sum(r.seconds for r in results)),
         distance_m=mean([r.distance_m for r in results]),
-        abs_yaw_deg=mean([abs(r.yaw_drift_deg) for r in results]),
+        abs_yaw_deg=mean(yaws),
+        abs_yaw_se_deg=se,
     )
 
 
@@ -160,12 +164,15 @@ class Trial:
     def rank(self, value: float, yaw_limit_deg: float | None = None) -> tuple:
         """The order candidates are kept in (least first): the fewest falls; then, where
         the heading drift limits the gain (``yaw_limit_deg``), the least mean |yaw| [deg]
-        beyond that limit; where every planned robot fell, the longest walked; then the
-        smallest ``|value|``. A lower
-        Γ does not outrank the simpler law: measured, higher gains lower Γ right up to
-        the gain where robots start to fall (docs/RESULTS.md)."""
+        plus one standard error beyond that limit (a few robots' mean misses the limit
+        about half the time where it lands just under it: on the default clip eval's
+        robots spread by 10° and six of them keep a mean within ±4°, docs/RESULTS.md);
+        where every planned robot fell, the longest walked; then the smallest
+        ``|value|``. A lower Γ does not outrank the simpler law: measured, higher gains
+        lower Γ right up to the gain where robots start to fall (docs/RESULTS.md)."""
         s = self.summary()
-        drift = 0.0 if yaw_limit_deg is None else max(0.0, s.abs_yaw_deg - yaw_limit_deg)
+        bound = s.abs_yaw_deg + s.abs_yaw_se_deg
+        drift = 0.0 if yaw_limit_deg is None else max(0.0, bound - yaw_limit_deg)
         planned = s.robots if self.robots is None else self.robots
         walked = -s.walked_s if s.falls == planned else 0.0
         return (s.falls, drift, walked, abs(value))

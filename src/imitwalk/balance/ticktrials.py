@@ -183,11 +183,12 @@ def gains_key(gains: dict) -> str:
 
 
 def say_table(lr: Learner, head: str, table) -> None:
-    """One progress line: per candidate, its falls and mean |yaw|."""
+    """One progress line: per candidate, its falls and mean |yaw| ± its standard error."""
     cells = []
     for v, t in table:
         s = t.summary()
-        walked = f"{s.falls}/{s.robots} fell, {s.abs_yaw_deg:.1f} deg" if s.robots else "not walked"
+        yaw = f"{s.abs_yaw_deg:.1f}±{s.abs_yaw_se_deg:.1f} deg"
+        walked = f"{s.falls}/{s.robots} fell, {yaw}" if s.robots else "not walked"
         cells.append(f"[{v:g}: {walked}]")
     lr.say(f"{head} {' '.join(cells)}")
 
