@@ -128,7 +128,7 @@ class WalkSummary:
     walked_s: float
     distance_m: float
     abs_yaw_deg: float
-    abs_yaw_se_deg: float = 0.0
+    abs_yaw_se_deg: float
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary (a row of the learning log's tables)."""
