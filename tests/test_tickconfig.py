@@ -68,7 +68,7 @@ def test_names_are_checked_with_the_valid_ones_listed():
     with pytest.raises(ConfigError, match=r"unknown protocol 'harder'; valid: bullet, eval, hard"):
         TickLearnConfig(train_protocol="harder")
     with pytest.raises(ConfigError, match=r"unknown protocol 'srvo'; valid: .*servo"):
-        apply_overrides(TickLearnConfig(), ["trials.torso_protocol=srvo"])
+        apply_overrides(TickLearnConfig(), ["trials.balance_protocol=srvo"])
     with pytest.raises(ConfigError, match=r"unknown setting 'lqr\.gain'; valid: .*lqr\.trust"):
         apply_overrides(TickLearnConfig(), ["lqr.gain=1"])
 

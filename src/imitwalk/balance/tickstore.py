@@ -49,12 +49,14 @@ class TrialGain:
 
 #: The trial-picked gains, in the order they are tried. The torso's pitch, measured,
 #: is held to the nominal robot's through both hip pitches: a servo spread along a
-#: leg's pitch chain changes how much the torso leans (docs/RESULTS.md). The heading is
-#: last: how far a walk drifts depends on every balance gain.
+#: leg's pitch chain changes how much the torso leans (docs/RESULTS.md). The balance
+#: gains are picked on robots with a wider servo spread than eval's, where a clip
+#: without feedback falls often enough to choose by. The heading is last: how far a
+#: walk drifts depends on every balance gain.
 TRIAL_GAINS = (
-    TrialGain("pitch", "ankle_pitch", "gyro_y"),
-    TrialGain("roll", "ankle_roll", "gyro_x"),
-    TrialGain("torso", "hip_pitch", "pitch", profiled=True, protocol="torso_protocol"),
+    TrialGain("pitch", "ankle_pitch", "gyro_y", protocol="balance_protocol"),
+    TrialGain("roll", "ankle_roll", "gyro_x", protocol="balance_protocol"),
+    TrialGain("torso", "hip_pitch", "pitch", profiled=True, protocol="balance_protocol"),
     TrialGain("heading", "turn", "heading", steers=True),
 )
 
