@@ -6,9 +6,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from imitwalk.balance.tickrun import TickResult, Trial
+from imitwalk.balance.ticktrials import best
 
 
-def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> Trial:
+def _walks(falls: int, robots: int = 8, yaw: float | tuple = 2.0, cost: float = 1.0) -> Trial:
+    """``robots`` walks, the first ``falls`` fallen; ``yaw``: every walk's drift [deg], or
+    one per walk."""
+    yaws = yaw if isinstance(yaw, tuple) else (yaw,) * robots
     return Trial(
         [
             TickResult(
@@ -17,10 +21,10 @@ def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> 
                 3.0 if j < falls else None,
                 3.0 if j < falls else 10.0,
                 1.0,
-                yaw,
+                yaws[j],
                 float("inf") if j < falls else cost,
             )
-            for j in range(robots)
+            for j in range(len(yaws))
         ]
     )
 
@@ -35,16 +39,16 @@ def _walks(falls: int, robots: int = 8, yaw: float = 2.0, cost: float = 1.0) -> 
 )
 def test_the_fewest_falls_win_then_the_smallest_gain_whatever_the_cost(rows):
     table = [(round(0.05 * i, 2), _walks(f, cost=c)) for i, (f, _, c) in enumerate(rows)]
-    best = min(table, key=lambda row: row[1].rank(row[0]))
+    kept = best(table)
     fewest = min(t.summary().falls for _, t in table)
-    assert best[1].summary().falls == fewest
-    assert best[0] == min(v for v, t in table if t.summary().falls == fewest)
+    assert kept[1].summary().falls == fewest
+    assert kept[0] == min(v for v, t in table if t.summary().falls == fewest)
 
 
 def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit():
     limit = 10.0  # deg, over the heading's whole walks
     table = [(0.0, _walks(0, yaw=12.0)), (-0.25, _walks(0, yaw=8.0)), (-0.5, _walks(0, yaw=3.0))]
-    pick = lambda t: min(t, key=lambda row: row[1].rank(row[0], limit))[0]  # noqa: E731
+    pick = lambda t: best(t, limit)[0]  # noqa: E731
     assert pick(table) == -0.25  # the least steering within the limit, not the least drift
     assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 9.0), (-0.5, 1.0))]) == 0.0
     assert pick([(v, _walks(0, yaw=y)) for v, y in ((0.0, 19.0), (-0.5, 15.0))]) == -0.5
@@ -53,18 +57,14 @@ def test_the_heading_gain_is_the_smallest_that_keeps_the_drift_under_its_limit()
 
 def test_a_drift_just_under_the_limit_must_hold_by_one_standard_error():
     limit = 10.0
-
-    def spread(yaws: tuple[float, ...]) -> Trial:
-        return Trial([TickResult(j, False, None, 30.0, 1.0, y, 1.0) for j, y in enumerate(yaws)])
-
-    pick = lambda t: min(t, key=lambda row: row[1].rank(row[0], limit))[0]  # noqa: E731
-    wide = spread((1.0, 2.0, 3.0, 10.0, 15.0, 17.0))  # mean 8.0, standard error 2.9
-    narrow = spread((7.0, 8.0, 8.0, 8.0, 8.0, 9.0))  # mean 8.0, standard error 0.3
-    steered = spread((4.0, 5.0, 5.0, 5.0, 5.0, 6.0))
+    pick = lambda t: best(t, limit)[0]  # noqa: E731
+    wide = _walks(0, yaw=(1.0, 2.0, 3.0, 10.0, 15.0, 17.0))  # mean 8.0, standard error 2.9
+    narrow = _walks(0, yaw=(7.0, 8.0, 8.0, 8.0, 8.0, 9.0))  # mean 8.0, standard error 0.3
+    steered = _walks(0, yaw=(4.0, 5.0, 5.0, 5.0, 5.0, 6.0))
     assert pick([(0.0, wide), (-0.25, steered)]) == -0.25
     assert pick([(0.0, narrow), (-0.25, steered)]) == 0.0
     # the sign of a drift does not count, only its size
-    signed = spread((-1.0, 2.0, -3.0, 10.0, -15.0, 17.0))
+    signed = _walks(0, yaw=(-1.0, 2.0, -3.0, 10.0, -15.0, 17.0))
     assert wide.summary().abs_yaw_se_deg == signed.summary().abs_yaw_se_deg
 
 
@@ -73,8 +73,8 @@ def test_where_every_robot_fell_the_longest_walked_wins():
         return Trial([TickResult(j, True, t, t, 0.1, 1.0, float("inf")) for j in range(4)])
 
     table = [(0.0, fell_at(2.2)), (0.5, fell_at(2.3)), (1.0, fell_at(6.0))]
-    assert min(table, key=lambda row: row[1].rank(row[0]))[0] == 1.0
+    assert best(table)[0] == 1.0
     # but a robot that stays up outranks any fall time, and with one up the walk's
     # length does not count
     table += [(2.0, _walks(3, robots=4)), (3.0, _walks(3, robots=4))]
-    assert min(table, key=lambda row: row[1].rank(row[0]))[0] == 2.0
+    assert best(table)[0] == 2.0
