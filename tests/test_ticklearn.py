@@ -85,9 +85,19 @@ def test_a_tiny_run_writes_its_folder(tick_run):
     assert len(schedule) == m["iterations"] >= 2
     assert schedule[0]["explore"] == cfg.lqr.explore and schedule[0]["held_out"] is None
     assert all(e["held_out"]["ratio_to_persistence"] > 0 for e in schedule[1:])
-    # the learned law first, so that its trial is whole
-    assert [r["fraction"] for r in log[-1]["table"]] == sorted(cfg.lqr.trust, reverse=True)
-    assert log[-1]["table"][0]["robots"] == cfg.trials.robots
+    # the trial-picked law alone first, on the heading trials' robots, whose walks it reuses
+    assert [r["fraction"] for r in log[-1]["table"]] == sorted(cfg.lqr.trust)
+    alone = log[-1]["table"][0]
+    heading = next(e for e in log if e["stage"] == "trials" and e["gain"] == "heading")
+    assert alone == {
+        "fraction": 0.0,
+        **next(
+            {k: v for k, v in r.items() if k != "value"}
+            for r in heading["table"]
+            if r["value"] == heading["kept"]
+        ),
+    }
+    assert alone["robots"] == cfg.trials.heading_robots
     assert log[-1]["kept"] == m["trust"] and log[-1]["scale"] == max(m["scales_passed"])
     # every simulated second is accounted for: trials, schedule and trust
     # (each candidate's trials once: a candidate in two tables was walked once)
