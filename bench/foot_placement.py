@@ -60,6 +60,7 @@ def falls(run, robot, laws, protocol, seeds: int, first: int = 0) -> dict:
             30.0,
             engine=protocol.engine,
             record=False,
+            **run.settings_of("learned"),  # the run's reference settings, under both laws
         )
         for d in draws
     ]

@@ -27,12 +27,14 @@ from imitwalk.parallel import run_parallel
 from imitwalk.robots import load_robot
 
 
-def walks(run, robot, laws, protocol, robots: int, first: int, seconds: float) -> dict:
-    """The falls of ``laws`` on ``robots`` robots of ``protocol``, with their draws."""
+def walks(run, robot, controller: str, protocol, robots: int, first: int, seconds: float) -> dict:
+    """The falls of the run's ``controller`` (its laws, and the reference played as the run
+    plays it for that controller) on ``robots`` robots of ``protocol``."""
+    laws = () if controller == OPEN_LOOP else tuple(run.laws[controller])
     draws = [protocol.draw(first + s, robot, run.ref.sim_options(), seconds) for s in range(robots)]
     jobs = [
         TickJob(run.path + "/reference.npz", robot, run.scale, laws, d.seed, d.options, seconds,
-                record=False)
+                record=False, **run.settings_of(controller))
         for d in draws
     ]  # fmt: skip
     res = run_parallel(run_tick_episode, jobs)
@@ -63,7 +65,6 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=30.0)
     args = ap.parse_args()
     run, robot = load_run(args.run_dir), load_robot(args.robot)
-    laws = () if args.controller == OPEN_LOOP else tuple(run.laws[args.controller])
     proto = load_protocol(args.protocol)
     variants = [proto.only((f,)) for f in proto.factors]
     if "pushes" in proto.factors:
@@ -71,7 +72,7 @@ def main() -> None:
     variants.append(proto)
     rows = []
     for p in variants:
-        row = walks(run, robot, laws, p, args.robots, args.first, args.seconds)
+        row = walks(run, robot, args.controller, p, args.robots, args.first, args.seconds)
         rows.append(row)
         print(json.dumps(row), flush=True)
     print(json.dumps({"run": args.run_dir, "controller": args.controller,
