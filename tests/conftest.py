@@ -38,6 +38,7 @@ TICK = [
     "trials.roll=0,0.1",
     "trials.heading=0,0.3",
     "trials.torso=0,-0.3",
+    "trials.tilt=0,0.3",
     "workers=1",
 ]
 

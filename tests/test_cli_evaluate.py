@@ -62,7 +62,10 @@ def test_evaluate_explains_the_falls_when_asked(run, capsys):
 @pytest.mark.parametrize(
     ("args", "expect"),
     [
-        (["--protocol", "nosuch"], "unknown protocol 'nosuch'; valid: bullet, eval, hard, servo"),
+        (
+            ["--protocol", "nosuch"],
+            "unknown protocol 'nosuch'; valid: bullet, eval, hard, servo, slope",
+        ),
         (
             ["--controllers", "nosuch"],
             "unknown controller 'nosuch'; valid: feedback, fixed, learned, open_loop",

@@ -41,7 +41,7 @@ def test_a_map_with_stop_returns_the_shortest_prefix_it_accepts_and_skips_the_re
         jobs = [(folder, x) for x in range(40)]
         assert run_parallel(_mark, jobs, workers=workers, stop=stop) == [0, 1, 4, 9]
         ran = len(list(folder.iterdir()))
-        assert 4 <= ran < 40  # the jobs not yet started when it stopped never ran
+        assert 4 <= ran <= 4 + workers - 1  # at most one job per other worker ran beyond it
     assert run_parallel(_square, [0, 1, 2], workers=2, stop=stop) == [0, 1, 4]  # never held
 
 

@@ -55,7 +55,7 @@ def test_learn_and_evaluate_every_walk(shared_mocap, tmp_path, capsys, clip, var
     assert ev["comparison"]["learned"]["robots"] == 3
     if variant == "extended":  # every trial-picked gain is one of its candidates
         trials = TrialConfig()
-        assert set(learned["feedback_gains"]) == {"pitch", "roll", "heading", "torso"}
+        assert set(learned["feedback_gains"]) == {"pitch", "roll", "heading", "torso", "tilt"}
         for name, value in learned["feedback_gains"].items():
             assert value in getattr(trials, name), name
         assert learned["trust"] in LqrConfig().trust

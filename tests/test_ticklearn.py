@@ -142,7 +142,7 @@ def test_the_controllers_a_run_builds(tick_run):
     assert fixed.gain("ankle_pitch", "gyro_y") == 0.05
 
 
-@pytest.mark.parametrize(("line", "stage"), [(3, "trials"), (7, "trials"), (12, "trust")])
+@pytest.mark.parametrize(("line", "stage"), [(3, "trials"), (7, "trials"), (13, "trust")])
 def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp_path, line, stage):
     ref = Reference.load(tick_reference)
     cut, resumed = _cut_and_resume(ref, robot, tmp_path / "cut", line)
@@ -157,7 +157,7 @@ def test_an_interrupted_run_resumes_exactly(tick_reference, tick_run, robot, tmp
 def cut_in_schedule(tick_reference, robot, tmp_path_factory):
     """A run interrupted in its second schedule iteration, resumed."""
     out = tmp_path_factory.mktemp("cut") / "run"
-    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 9)
+    cut, resumed = _cut_and_resume(Reference.load(tick_reference), robot, out, 10)
     assert cut["stage"] == "schedule" and cut["iteration"] == 1
     return out, resumed
 
@@ -204,7 +204,7 @@ def test_a_run_without_the_model_based_law_keeps_the_trial_picked_one(
     res = json.loads(capsys.readouterr().out)
     assert res["variant"] == "extended" and res["run_dir"] == str(out)
     assert res["iterations"] == 0 and res["trust"] is None
-    assert set(res["feedback_gains"]) == {"pitch", "roll", "heading", "torso"}
+    assert set(res["feedback_gains"]) == {"pitch", "roll", "heading", "torso", "tilt"}
     rd = RunDir(out)
     assert not rd.exists("learned.npz") and rd.read_json("checkpoint.json")["stage"] == "done"
     laws = load_laws(out)

@@ -9,7 +9,9 @@ the executor or the number of workers.
 
 With ``stop``, a map can end early: results are taken in job order, and once ``stop``
 holds for those taken so far, the jobs not yet started are cancelled and that prefix is
-returned. Which prefix that is does not depend on the executor either.
+returned. Which prefix that is does not depend on the executor either. The process pool
+then runs at most one job per worker ahead of the first result not yet taken, so that
+at most ``workers - 1`` jobs beyond the prefix are paid for.
 """
 
 from __future__ import annotations
@@ -42,6 +44,9 @@ def run_parallel(
     if given, is asked after each result in job order; once it says True, the rest of
     the jobs are cancelled (those already running finish, unused) and the results so far
     are returned: the shortest prefix of ``[fn(j) for j in jobs]`` that ``stop`` accepts.
+    With ``stop`` the process pool starts job ``k + workers`` only once job ``k``'s
+    result is taken (a worker may wait on a slower job before it), so that no more than
+    ``workers - 1`` jobs run beyond that prefix.
     ``spent``, if given, receives the results of the jobs beyond that prefix that ran to
     their end all the same (unused, but paid for), in job order. Ctrl-C (sent to the
     whole process group, as a terminal does) raises ``KeyboardInterrupt`` here: the jobs
@@ -57,11 +62,18 @@ def run_parallel(
     if workers <= 1:
         return _until(jobs, fn, stop)
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_leave_ctrl_c_to_parent)
+    ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
     try:
         with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
-            futures = [pool.submit(fn, j) for j in jobs]
-        out = _until(futures, lambda f: f.result(), stop)
+            futures = [pool.submit(fn, j) for j in jobs[:ahead]]
+        out: list = []
+        for k in range(len(jobs)):
+            out.append(futures[k].result())
+            if stop is not None and stop(out):
+                break
+            if len(futures) < len(jobs):
+                futures.append(pool.submit(fn, jobs[len(futures)]))
         ran = [f for f in futures[len(out) :] if not f.cancel()]
         if spent is not None:
             spent.extend(f.result() for f in ran)

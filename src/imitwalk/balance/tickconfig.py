@@ -54,6 +54,16 @@ class TrialConfig:
         torso: candidate gains pitch → hip_pitch [rad per rad]: the torso's measured
             pitch less the nominal robot's at that loop tick, fed to both hip pitches; a
             negative gain leans a torso that pitches forward back.
+        tilt: candidate gains pitch → ankle_pitch [rad per rad]: the same measured pitch
+            less the nominal robot's, fed to both ankle pitches, which tilt the whole
+            body; a positive gain pitches a body that leans forward back. The gyro_y
+            gain damps a fall; this one holds the lean against a steady push (a slope, a
+            sagging servo), which the gyro's rate does not see. On validation robots
+            0.1 did no better than 0.2 on any clip and 0.5 fell more than 0.2 on 07_04
+            (docs/RESULTS.md), so neither is a candidate.
+        tilt_protocol: the protocol the tilt gain's training robots are drawn from: on
+            ``servo``'s flat floors trials of a few robots rarely see what it is for
+            (``slope``: ``servo``'s robots on the hard protocol's slopes).
         balance_protocol: the protocol the balance gains' (pitch, roll, torso) training
             robots are drawn from (a shipped name or a ``.json``): on ``eval``'s, trials
             of a few robots see no falls under any candidate, and 07_04 keeps no roll
@@ -76,6 +86,8 @@ class TrialConfig:
     roll: tuple[float, ...] = (0.0, 0.05, 0.1)
     heading: tuple[float, ...] = (0.0, -0.25, -0.5)
     torso: tuple[float, ...] = (0.0, -0.15, -0.3)
+    tilt: tuple[float, ...] = (0.0, 0.2, 0.3)
+    tilt_protocol: str = "slope"
     balance_protocol: str = "servo"
     yaw_limit_deg: float = 10.0
     box: float = 0.15
@@ -91,7 +103,9 @@ class TrialConfig:
         _range("trials.roll", self.roll, -0.5, 0.5)
         _range("trials.heading", self.heading, -2.0, 2.0)
         _range("trials.torso", self.torso, -1.0, 1.0)
+        _range("trials.tilt", self.tilt, -1.0, 1.0)
         load_protocol(self.balance_protocol)  # a one-line error if unknown
+        load_protocol(self.tilt_protocol)
         _range("trials.yaw_limit_deg", (self.yaw_limit_deg,), 0.0, 180.0)
         _range("trials.box", (self.box,), 0.001, 0.5)
         _range("trials.robots", (self.robots,), 1, 1000)

@@ -51,12 +51,14 @@ class TrialGain:
 #: is held to the nominal robot's through both hip pitches: a servo spread along a
 #: leg's pitch chain changes how much the torso leans (docs/RESULTS.md). The balance
 #: gains are picked on robots with a wider servo spread than eval's, where a clip
-#: without feedback falls often enough to choose by. The heading is last: how far a
-#: walk drifts depends on every balance gain.
+#: without feedback falls often enough to choose by. The same pitch through both ankle
+#: pitches (tilt) holds the whole body's lean, on robots that also stand on slopes. The
+#: heading is last: how far a walk drifts depends on every balance gain.
 TRIAL_GAINS = (
     TrialGain("pitch", "ankle_pitch", "gyro_y", protocol="balance_protocol"),
     TrialGain("roll", "ankle_roll", "gyro_x", protocol="balance_protocol"),
     TrialGain("torso", "hip_pitch", "pitch", profiled=True, protocol="balance_protocol"),
+    TrialGain("tilt", "ankle_pitch", "pitch", profiled=True, protocol="tilt_protocol"),
     TrialGain("heading", "turn", "heading", steers=True),
 )
 
@@ -64,7 +66,7 @@ TRIAL_GAINS = (
 def feedback_law(cfg: TickLearnConfig, gains: dict, profiles: dict | None = None) -> FeedbackLaw:
     """The trial-picked law with ``gains`` by setting name (a missing one is 0) and the
     nominal ``profiles`` by feature, each ``(N,)`` per loop tick (a missing one is 0)."""
-    channels = tuple(g.channel for g in TRIAL_GAINS)
+    channels = tuple(dict.fromkeys(g.channel for g in TRIAL_GAINS))
     features = tuple(dict.fromkeys(g.feature for g in TRIAL_GAINS))
     profiles = profiles or {}
     n = max((len(p) for p in profiles.values()), default=1)
