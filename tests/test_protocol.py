@@ -49,6 +49,21 @@ def test_servo_draws_evals_robots_with_hards_servo_spread(robot):
         assert o.kp_jitter == (0.2 if seed else e.kp_jitter)
 
 
+def test_slope_draws_servos_robots_on_hards_slopes(robot):
+    slope, servo = load_protocol("slope"), load_protocol("servo")
+    hard = load_protocol("hard").factors["slope"]
+    assert [slope.factors["slope"][k] for k in ("min_deg", "max_deg")] == [-3.0, 3.0]
+    assert [hard[k] for k in ("min_deg", "max_deg")] == [-3.0, 3.0]
+    for seed in range(8):
+        o, s = slope.draw(seed, robot).options, servo.draw(seed, robot).options
+        same = ("friction", "mass_jitter", "init_twist", "kp_jitter")
+        assert [getattr(o, k) for k in same] == [getattr(s, k) for k in same]
+        if seed == 0:  # the nominal robot stands on a flat floor
+            assert o.slope_deg == 0.0
+        else:
+            assert -3.0 <= o.slope_deg <= 3.0 and o.slope_deg != 0.0
+
+
 def test_hard_draws_cover_their_ranges(robot):
     p = load_protocol("hard")
     draws = [p.draw(s, robot, seconds=30.0) for s in range(40)]

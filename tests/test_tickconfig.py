@@ -18,6 +18,7 @@ OUT_OF_RANGE = [
     ("trials.roll", "-0.7", "-0.5..0.5"),
     ("trials.heading", "0,2.5", "-2..2"),
     ("trials.torso", "0,-1.5", "-1..1"),
+    ("trials.tilt", "0,1.5", "-1..1"),
     ("trials.box", "0.6", "0.001..0.5"),
     ("trials.box", "0", "0.001..0.5"),
     ("trials.robots", "0", "1..1000"),
@@ -69,6 +70,8 @@ def test_names_are_checked_with_the_valid_ones_listed():
         TickLearnConfig(train_protocol="harder")
     with pytest.raises(ConfigError, match=r"unknown protocol 'srvo'; valid: .*servo"):
         apply_overrides(TickLearnConfig(), ["trials.balance_protocol=srvo"])
+    with pytest.raises(ConfigError, match=r"unknown protocol 'slop'; valid: .*slope"):
+        apply_overrides(TickLearnConfig(), ["trials.tilt_protocol=slop"])
     with pytest.raises(ConfigError, match=r"unknown setting 'lqr\.gain'; valid: .*lqr\.trust"):
         apply_overrides(TickLearnConfig(), ["lqr.gain=1"])
 
