@@ -64,16 +64,17 @@ def run_parallel(
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_leave_ctrl_c_to_parent)
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
+
+    def in_order():  # each next job is started only once the result before is taken
+        for k in range(len(jobs)):
+            yield futures[k]
+            if len(futures) < len(jobs):
+                futures.append(pool.submit(fn, jobs[len(futures)]))
+
     try:
         with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
             futures = [pool.submit(fn, j) for j in jobs[:ahead]]
-        out: list = []
-        for k in range(len(jobs)):
-            out.append(futures[k].result())
-            if stop is not None and stop(out):
-                break
-            if len(futures) < len(jobs):
-                futures.append(pool.submit(fn, jobs[len(futures)]))
+        out = _until(in_order(), lambda f: f.result(), stop)
         ran = [f for f in futures[len(out) :] if not f.cancel()]
         if spent is not None:
             spent.extend(f.result() for f in ran)

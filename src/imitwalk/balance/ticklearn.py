@@ -130,7 +130,7 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
     where the trial-picked law alone did not fall, a larger fraction could at best tie,
     and lose on its size, so it is not walked. Measured: this saves 280 simulated seconds
     on every run whose trial-picked law did not fall, and every run keeps its law
-    (docs/RESULTS.md, "Learning cost")."""
+    (BENCHMARKS.md, "Learning cost")."""
     cfg = lr.cfg
     if learned is None:
         state.trust, state.stage = 0.0, "done"
