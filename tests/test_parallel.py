@@ -11,7 +11,7 @@ import time
 import pytest
 
 from imitwalk.errors import ConfigError
-from imitwalk.parallel import run_parallel
+from imitwalk.parallel import abandoned, run_parallel
 
 
 def _square(x: int) -> int:
@@ -57,6 +57,29 @@ def test_a_stopped_map_hands_back_every_job_that_ran_beyond_its_prefix(tmp_path)
         ran = sorted(int(p.stem) for p in folder.iterdir())
         assert out == [0, 1, 4, 9]
         assert [x * x for x in ran[4:]] == spent  # in job order
+
+
+def _long_unless_abandoned(x: int) -> tuple[int, int]:
+    """``(x, ticks)``: jobs from 4 on tick 100 times unless abandoned first (job 3 waits
+    long enough for job 4 to have started)."""
+    time.sleep(0.3 if x == 3 else 0.0)
+    ticks = 0
+    while x >= 4 and ticks < 100 and not abandoned():
+        time.sleep(0.01)
+        ticks += 1
+    return x, ticks
+
+
+def test_the_jobs_running_beyond_a_stopped_maps_prefix_see_that_they_are_abandoned():
+    """What runs beyond the prefix may end early: it is paid for, not used."""
+    assert not abandoned()  # outside a worker
+    spent: list = []
+    out = run_parallel(_long_unless_abandoned, list(range(40)), 2, lambda s: len(s) == 4, spent)
+    assert out == [(x, 0) for x in range(4)]
+    assert [x for x, _ in spent] == [4]  # the one job started beyond the prefix ...
+    assert spent[0][1] < 100  # ... ended early
+    full = run_parallel(_long_unless_abandoned, [4, 5], 2)  # no stop: every job runs out
+    assert full == [(4, 100), (5, 100)]
 
 
 _INTERRUPTED = """

@@ -11,11 +11,13 @@ With ``stop``, a map can end early: results are taken in job order, and once ``s
 holds for those taken so far, the jobs not yet started are cancelled and that prefix is
 returned. Which prefix that is does not depend on the executor either. The process pool
 then runs at most one job per worker ahead of the first result not yet taken, so that
-at most ``workers - 1`` jobs beyond the prefix are paid for.
+at most ``workers - 1`` jobs beyond the prefix are paid for, and a job that asks
+:func:`abandoned` as it goes can end those early.
 """
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import signal
 import threading
@@ -25,9 +27,20 @@ from contextlib import contextmanager
 
 from imitwalk.errors import ConfigError, unknown_name
 
-__all__ = ["EXECUTORS", "run_parallel"]
+__all__ = ["EXECUTORS", "abandoned", "run_parallel"]
 
 EXECUTORS = ("process", "ray")
+
+#: In a pool's worker: the event its map sets once ``stop`` has held (``None`` elsewhere).
+_ABANDONED = None
+
+
+def abandoned() -> bool:
+    """Whether the map running this job no longer needs its result: ``stop`` held on the
+    results before it. A long job may ask this as it goes and end early, with whatever
+    partial result it has (it goes to ``spent``). Always ``False`` outside a pool's
+    worker, where every job runs to its end."""
+    return _ABANDONED is not None and _ABANDONED.is_set()
 
 
 def run_parallel(
@@ -47,8 +60,9 @@ def run_parallel(
     With ``stop`` the process pool starts job ``k + workers`` only once job ``k``'s
     result is taken (a worker may wait on a slower job before it), so that no more than
     ``workers - 1`` jobs run beyond that prefix.
-    ``spent``, if given, receives the results of the jobs beyond that prefix that ran to
-    their end all the same (unused, but paid for), in job order. Ctrl-C (sent to the
+    ``spent``, if given, receives the results of the jobs beyond that prefix that ran all
+    the same (unused, but paid for), in job order: to their end, or to where they saw
+    :func:`abandoned`. Ctrl-C (sent to the
     whole process group, as a terminal does) raises ``KeyboardInterrupt`` here: the jobs
     not yet started are cancelled, the running ones end, and no worker is left behind.
     """
@@ -61,7 +75,10 @@ def run_parallel(
     workers = min(len(jobs), workers or default)
     if workers <= 1:
         return _until(jobs, fn, stop)
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_leave_ctrl_c_to_parent)
+    ctx = multiprocessing.get_context()
+    done = ctx.Event()
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                               initargs=(done,))  # fmt: skip
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
 
@@ -75,10 +92,12 @@ def run_parallel(
         with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
             futures = [pool.submit(fn, j) for j in jobs[:ahead]]
         out = _until(in_order(), lambda f: f.result(), stop)
+        done.set()  # the jobs still running may end early
         ran = [f for f in futures[len(out) :] if not f.cancel()]
         if spent is not None:
             spent.extend(f.result() for f in ran)
     except BaseException:  # Ctrl-C or a failed job: drop the jobs not yet started
+        done.set()
         for f in futures:
             f.cancel()
         pool.shutdown(wait=False, cancel_futures=True)
@@ -101,10 +120,13 @@ def _ctrl_c_held():
         block(signal.SIG_SETMASK, old)
 
 
-def _leave_ctrl_c_to_parent() -> None:
-    """A worker ignores Ctrl-C: the parent cancels the jobs not yet started and the
-    running ones end. (An idle worker interrupted while it waits for a job dies holding
-    the pool's queue, and the pool then waits for it forever.)"""
+def _worker_init(done) -> None:
+    """A worker keeps its map's ``done`` event (:func:`abandoned`) and ignores Ctrl-C: the
+    parent cancels the jobs not yet started and the running ones end. (An idle worker
+    interrupted while it waits for a job dies holding the pool's queue, and the pool then
+    waits for it forever.)"""
+    global _ABANDONED
+    _ABANDONED = done
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
+from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.types import SimOptions
 
@@ -81,7 +82,8 @@ def _reference(path: str):
 
 
 def run_tick_episode(job: TickJob) -> TickResult:
-    """Walk ``job``'s laws on its robot (runs in a worker process)."""
+    """Walk ``job``'s laws on its robot (runs in a worker process); a walk its map no
+    longer needs (:func:`~imitwalk.parallel.abandoned`) ends there, its seconds paid."""
     from imitwalk.sim.metrics import walk_metrics
     from imitwalk.sim.mujoco import make_plant, run
 
@@ -95,7 +97,7 @@ def run_tick_episode(job: TickJob) -> TickResult:
         offsets=offsets, wait=job.wait,
     )  # fmt: skip
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
-    ro = run(plant, policy, len(policy.q_ref))
+    ro = run(plant, policy, len(policy.q_ref), abandon=abandoned)
     m = walk_metrics(
         ro,
         ref.expected_distance(job.scale, ro.seconds),

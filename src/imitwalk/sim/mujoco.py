@@ -236,6 +236,7 @@ def run(
     steps: int,
     q0: np.ndarray | None = None,
     stop_on_fall: bool = True,
+    abandon: Callable[[], bool] | None = None,
 ) -> Rollout:
     """Run ``policy(tick, obs) -> (n,) targets`` for ``steps`` control periods.
 
@@ -249,6 +250,8 @@ def run(
             declares one (a controller starts where its trajectory starts, as open-loop
             playback of that trajectory does), else standing.
         stop_on_fall: end the run at the first fall.
+        abandon: asked after every tick; once it holds, the run ends there (its result
+            is no longer needed: :func:`imitwalk.parallel.abandoned`).
     """
     if q0 is None:
         q0 = getattr(policy, "q0", None)
@@ -264,7 +267,7 @@ def run(
         row = (obs.t, plant.commanded, obs.joints, obs.gyro, obs.accel, obs.foot_force, pos, quat)
         for key, val in zip(rec, (*row, plant.qpos(), plant.torques()), strict=True):
             rec[key].append(val)
-        if plant.fell and stop_on_fall:
+        if (plant.fell and stop_on_fall) or (abandon is not None and abandon()):
             break
     arr = {k: np.asarray(v) for k, v in rec.items()}
     empty = len(arr["t"]) == 0
