@@ -35,7 +35,7 @@ def _json_default(v):
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
 
 
-_TICK_ONLY = ("trial_falls_at_top", "feedback_gains", "trust", "reference_settings")
+_TICK_ONLY = ("trial_scale", "trial_falls", "feedback_gains", "trust", "reference_settings")
 _FAITHFUL_ONLY = ("variant", "gait")
 
 
@@ -50,7 +50,8 @@ class LearnSummary:
         sim_seconds_used_for_learning: simulated time of every learning walk [s];
         wall_seconds_for_learning: wall time [s].
         config: the learner's settings.
-        trial_falls_at_top: ``tick``: falls of the kept law's trials at the top scale.
+        trial_scale: ``tick``: the scale the trials walked at (the top one unless no
+            candidate walked a robot there); trial_falls: the kept law's falls there.
         feedback_gains: ``tick``: the gains the trials kept, by channel.
         trust: ``tick``: the fraction of the model-based law kept (0: none).
         reference_settings: ``tick``: how the trials chose to play the reference, by
@@ -67,7 +68,8 @@ class LearnSummary:
     sim_seconds_used_for_learning: float
     wall_seconds_for_learning: float
     config: dict
-    trial_falls_at_top: int | None = None
+    trial_scale: float | None = None
+    trial_falls: int | None = None
     feedback_gains: dict | None = None
     trust: float | None = None
     reference_settings: dict | None = None

@@ -127,8 +127,8 @@ class LqrConfig:
         width, ridge: the model's phase kernels [ticks] and regularisation.
         explore: exploration amplitude [rad] in a scale's first iteration.
         box: each channel's limit [rad].
-        trust: the fractions of the learned law tried at the top scale (its gains ×
-            each), the largest first; the smallest that falls least is kept.
+        trust: the fractions of the learned law tried at the trials' scale (its gains ×
+            each), the smallest first; the smallest that falls least is kept.
     """
 
     enabled: bool = True

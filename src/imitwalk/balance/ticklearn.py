@@ -10,22 +10,25 @@ and ends where an uninterrupted one would:
    feedback law gyro_y → ankle pitch, gyro_x → ankle roll, the torso's pitch less the
    nominal robot's → both hip pitches (on training robots with a wider servo spread),
    heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
-   chosen in turn from its candidates by trials at the top scale (:class:`Trial`) on
-   many short walks of training robots: the baseline the learned law starts from.
+   chosen in turn from its candidates by trials (:class:`Trial`) on many short walks of
+   training robots: the baseline the learned law starts from. The trials walk at the top
+   scale, or lower where no candidate walked any robot there
+   (:func:`~imitwalk.balance.ticktrials.blind`).
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.balance.tickmodel.PhaseModel`), turn it into gains by
    the receding-horizon eq.-6 search (:func:`~imitwalk.balance.lqr.horizon_gains`) and go on;
    a scale is passed by an iteration without exploration in which no training robot
    falls. The learned law acts on top of the trial-picked one.
-3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the top
-   scale, on the heading trials' robots (so the trial-picked law's walks there are
+3. **Trust** (:func:`_trust`): the learned law's gains × each of ``lqr.trust`` at the
+   trials' scale, on the heading trials' robots (so the trial-picked law's walks there are
    reused); the smallest fraction that falls least is kept (0: the trial-picked law
    alone).
 
-``scale_reached`` is the top scale if the kept law walked every trial robot there without
-a fall, else the highest scale the schedule passed (the first if none): the controllers
-are judged there. ``scales_passed``: how far the schedule carried the model-based law.
+``scale_reached`` is the trials' scale if the kept law walked every trial robot there
+without a fall, or the highest scale the schedule passed if that is higher (the first
+scale if neither): the controllers are judged there. ``scales_passed``: how far the
+schedule carried the model-based law.
 
 Training robots come from ``train_protocol`` with seeds no evaluation uses.
 """
@@ -122,8 +125,8 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
 
 
 def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
-    """Stage 3: how much of the learned law to keep, by the trials at the top scale (the
-    law the schedule learned at the highest scale it passed) on the heading trials'
+    """Stage 3: how much of the learned law to keep, by the trials at the trials' scale
+    (the law the schedule learned at the highest scale it passed) on the heading trials'
     robots: their 30 s walks are the evaluation's length, and the trial-picked law alone
     (fraction 0) has walked them already. The smallest fraction is walked first and the
     larger ones are cut as every trial is (:func:`~imitwalk.balance.ticktrials.most_falls`):
@@ -144,9 +147,9 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
         table.append((float(frac), run))
     kept = best(table)[0]
     state.trust, state.stage = kept, "done"
-    log.append({"stage": "trust", "scale": lr.scales[-1], "kept": kept,
+    log.append({"stage": "trust", "scale": lr.trial_scale(state), "kept": kept,
                 "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table]})  # fmt: skip
-    say_table(lr, f"trust at {lr.scales[-1]:g}: kept {kept:g}", table)
+    say_table(lr, f"trust at {lr.trial_scale(state):g}: kept {kept:g}", table)
 
 
 def learn_tick(
@@ -176,8 +179,8 @@ def learn_tick(
         checkpoint(lr, state, log, data)
     kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
     row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
-    top_falls = int(row["falls"])
-    reached = lr.scales[-1] if top_falls == 0 else max(state.passed, default=lr.scales[0])
+    trial_falls, tried = int(row["falls"]), lr.trial_scale(state)
+    reached = max([*state.passed, *([tried] if trial_falls == 0 else [])], default=lr.scales[0])
     summary = LearnSummary(
         learner="tick",
         scale_reached=reached,
@@ -186,7 +189,8 @@ def learn_tick(
         sim_seconds_used_for_learning=state.sim_seconds,
         wall_seconds_for_learning=state.wall_seconds,
         config=to_dict(config),
-        trial_falls_at_top=top_falls,
+        trial_scale=tried,
+        trial_falls=trial_falls,
         feedback_gains=state.gains,
         trust=state.trust,
         reference_settings=state.settings,

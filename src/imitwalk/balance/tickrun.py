@@ -156,7 +156,7 @@ def summarize(results: list[TickResult]) -> WalkSummary:
 
 @dataclass(frozen=True)
 class Trial:
-    """One candidate's walks at the top scale, on the training robots: ``results``, the
+    """One candidate's walks at the trial scale, on the training robots: ``results``, the
     first of ``robots`` planned ones (``None``: all of them; fewer once a candidate that
     can no longer be kept was stopped, :func:`~imitwalk.balance.ticktrials.trial`)."""
 

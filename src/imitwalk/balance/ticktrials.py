@@ -1,11 +1,18 @@
 """The per-tick learner's shared context and its first stage, the trials
 (:mod:`imitwalk.balance.ticklearn` runs the stages).
 
-Trials pick, one setting at a time and each from its candidates, at the top scale, on
+Trials pick, one setting at a time and each from its candidates, at the trial scale, on
 many short walks of training robots (:class:`~imitwalk.balance.tickrun.Trial`): first,
 with no feedback, how the reference is played (:data:`REFERENCE_SETTINGS`), then the
 feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`). A gain whose
 feature is held to the nominal robot's profile first walks the nominal robot once.
+
+The trial scale is the top scale until a table cannot tell its candidates apart there:
+every candidate fell on every robot (:func:`blind`). That table is then walked again one
+scale of the schedule lower, and so on down to the schedule's first; the trials after it
+stay at the scale it ended at, and so does the trust trial. A robot that cannot walk at
+the top scale under any candidate has its gains picked where it can (G1), and one that
+can (hoap2, OP3) is never walked lower.
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ __all__ = [
     "Learner",
     "TickProgress",
     "best",
+    "blind",
     "checkpoint",
     "gains_key",
     "most_falls",
@@ -54,6 +62,8 @@ class TickProgress:
             as the trials picked them so far; gains: the trial-picked gains so far, by
             setting name; trial: the next gain; profiles: the nominal robot's profile
             of each profiled feature, per loop tick (:func:`profile`).
+        trial_scale: the scale the trials walk at (``None``: the top scale; lowered
+            where a table is :func:`blind`).
         scale_index, iteration: where the schedule is; passed: scales passed.
         trust: the fraction of the learned law kept (``None`` until decided).
         tried: every candidate's trial results so far, by key (run once each).
@@ -65,6 +75,7 @@ class TickProgress:
     gains: dict = field(default_factory=dict)
     trial: int = 0
     profiles: dict = field(default_factory=dict)
+    trial_scale: float | None = None
     scale_index: int = 0
     iteration: int = 0
     passed: list = field(default_factory=list)
@@ -83,6 +94,20 @@ class Learner:
         self.protocol = load_protocol(cfg.train_protocol)
         self.scales = cfg.scales()
         self.ref_path = str(rd.file("reference.npz"))
+
+    def trial_scale(self, state: TickProgress) -> float:
+        """The scale the trials walk at (:attr:`TickProgress.trial_scale`)."""
+        return self.scales[-1] if state.trial_scale is None else state.trial_scale
+
+    def lower(self, state: TickProgress, table: list) -> bool:
+        """Whether ``table`` is :func:`blind` and the trials can go one scale lower; if
+        so, they do (``state.trial_scale``)."""
+        below = [s for s in self.scales if s < self.trial_scale(state) - 1e-9]
+        if not below or not blind(table):
+            return False
+        state.trial_scale = below[-1]
+        self.say(f"trials: every candidate fell on every robot; trials go on at {below[-1]:g}")
+        return True
 
     def robots(self, n: int, first: int, seconds: float, protocol: str | None = None):
         """``n`` training robots from the ``first``-th on, drawn from ``protocol`` (a
@@ -122,7 +147,7 @@ class Learner:
 
 def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most=None,
           protocol=None) -> Trial:  # fmt: skip
-    """The trials of ``laws`` at the top scale (the heading's walks if ``heading``), the
+    """The trials of ``laws`` at the trial scale (the heading's walks if ``heading``), the
     reference played with ``settings`` (default: the ones kept), on training robots from
     ``protocol`` (``None``: ``train_protocol``), run once per key (kept in the
     checkpoint, so that a resumed run neither repeats nor re-counts them).
@@ -141,13 +166,14 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     settings = state.settings if settings is None else settings
     key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
     key = f"{key}@{n}x{seconds:g}s" + ("" if protocol is None else f" [{protocol}]")
+    key += "" if state.trial_scale is None else f" at {state.trial_scale:g}"
     done = [TickResult(**r) for r in state.tried.get(key, [])]
     limit = n if most is None else most
     fell = sum(r.fell for r in done)
     if len(done) < n and fell <= limit:
         draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds, protocol)
         stop = None if most is None else (lambda out: fell + sum(r.fell for r in out) > limit)
-        res = lr.run(state, lr.scales[-1], laws, draws, seconds, settings=settings,
+        res = lr.run(state, lr.trial_scale(state), laws, draws, seconds, settings=settings,
                      first=len(done), stop=stop)  # fmt: skip
         done += res
     state.tried[key] = [asdict(replace(r, episode=None)) for r in done]
@@ -157,6 +183,17 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
 def best(table: list, yaw_limit_deg: float | None = None):
     """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`)."""
     return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
+
+
+def blind(table: list) -> bool:
+    """Whether every candidate of ``table`` (rows ``(value, Trial)``) fell on every one
+    of its planned robots: the trials could then rank them only by the time walked, which
+    at a scale no candidate can walk says little (on G1 it picked a tilt gain that fell
+    every evaluation robot at 0.3, where trials at 0.3 refuse it)."""
+    return len(table) > 1 and all(
+        t.robots is not None and len(t.results) == t.robots and t.summary().falls == t.robots
+        for _, t in table
+    )
 
 
 def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) -> int | None:
@@ -193,36 +230,54 @@ def say_table(lr: Learner, head: str, table) -> None:
     lr.say(f"{head} {' '.join(cells)}")
 
 
+def _table(lr: Learner, state: TickProgress, values, walk, yaw_limit_deg=None) -> list:
+    """The rows ``(value, Trial)`` of ``values``, each walked by ``walk(value, most)``
+    (``most``: :func:`most_falls` against the rows before it) at the trial scale, and
+    walked again one scale lower while the table is :func:`blind` there
+    (:meth:`Learner.lower`)."""
+    while True:
+        table: list[tuple[float, Trial]] = []
+        for value in values:
+            most = most_falls(table, value, yaw_limit_deg)
+            table.append((float(value), walk(float(value), most)))
+        if not lr.lower(state, table):
+            return table
+
+
 def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
     """Stage 1's first choices: how the reference is played, one setting at a time, with
-    no feedback, at the top scale. Without a task-space plan (the paper's mapping) the
+    no feedback, at the trial scale. Without a task-space plan (the paper's mapping) the
     reference is played as it is."""
     cfg = lr.cfg
     laws = [feedback_law(cfg, {})]
     for name in REFERENCE_SETTINGS[len(state.settings) :]:
         candidates = getattr(cfg.trials, name) if lr.ref.plan else (0.0,)
-        table: list[tuple[float, Trial]] = []
-        for value in candidates:
-            settings = {**state.settings, name: float(value)}
-            run = trial(lr, state, gains_key({}), laws, False, settings, most_falls(table, value))
-            table.append((float(value), run))
+
+        def walk(value, most, name=name):
+            settings = {**state.settings, name: value}
+            return trial(lr, state, gains_key({}), laws, False, settings, most)
+
+        table = _table(lr, state, candidates, walk)
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
-        log.append({"stage": "trials", "gain": name, "kept": kept, "table": rows})
+        log.append({"stage": "trials", "gain": name, "kept": kept,
+                    "scale": lr.trial_scale(state), "table": rows})  # fmt: skip
         say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
         checkpoint(lr, state, log)
 
 
 def profile(lr: Learner, state: TickProgress, feature: str) -> None:
     """The nominal robot's ``feature`` per loop tick (into ``state.profiles``), under the
-    law the trials kept so far: one walk of ``trials.seconds`` at the top scale, its
+    law the trials kept so far: one walk of ``trials.seconds`` at the trial scale (taken
+    once: a later drop of that scale does not take it again), its
     start-up and, if it fell, its last half second left out (its start-up too if nothing
     else is left)."""
     cfg, ref = lr.cfg, lr.ref
     key = f"nominal robot: {feature} profile@{cfg.trials.seconds:g}s"
+    key += "" if state.trial_scale is None else f" at {state.trial_scale:g}"
     laws = [feedback_law(cfg, state.gains, state.profiles)]
     nominal = RobotDraw(0, ref.sim_options())
-    (res,) = lr.run(state, lr.scales[-1], laws, [nominal], cfg.trials.seconds)
+    (res,) = lr.run(state, lr.trial_scale(state), laws, [nominal], cfg.trials.seconds)
     ep = res.episode
     assert ep is not None  # walks record their ticks
     end = len(ep.phase) - (round(0.5 / ref.dt) if res.fell else 0)
@@ -237,7 +292,7 @@ def profile(lr: Learner, state: TickProgress, feature: str) -> None:
 
 def trials(lr: Learner, state: TickProgress, log: list) -> None:
     """Stage 1: how the reference is played, then one gain at a time, each from its
-    candidates, at the top scale."""
+    candidates, at the trial scale."""
     cfg = lr.cfg
     _reference_settings(lr, state, log)
     while state.trial < len(TRIAL_GAINS):
@@ -247,17 +302,18 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
             checkpoint(lr, state, log)
         limit = cfg.trials.yaw_limit_deg if g.steers else None
         protocol = getattr(cfg.trials, g.protocol) if g.protocol else None
-        table: list[tuple[float, Trial]] = []
-        for value in getattr(cfg.trials, g.name):
-            gains = {**state.gains, g.name: float(value)}
+
+        def walk(value, most, g=g, protocol=protocol):
+            gains = {**state.gains, g.name: value}
             laws = [feedback_law(cfg, gains, state.profiles)]
-            most = most_falls(table, value, limit)
-            run = trial(lr, state, gains_key(gains), laws, g.steers, most=most, protocol=protocol)
-            table.append((float(value), run))
+            return trial(lr, state, gains_key(gains), laws, g.steers, most=most, protocol=protocol)
+
+        table = _table(lr, state, getattr(cfg.trials, g.name), walk, limit)
         state.gains[g.name] = kept = best(table, limit)[0]
         log.append(
             {"stage": "trials", "gain": g.name, "channel": g.channel, "feature": g.feature,
-             "kept": kept, "protocol": protocol or cfg.train_protocol,
+             "kept": kept, "scale": lr.trial_scale(state),
+             "protocol": protocol or cfg.train_protocol,
              "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
         )  # fmt: skip
         say_table(lr, f"trials: {g.feature} -> {g.channel} = {kept:g}", table)
