@@ -72,6 +72,10 @@ def test_a_tiny_run_writes_its_folder(tick_run):
     for entry, name in zip(log, ("feedforward", "wait"), strict=False):
         assert (entry["gain"], entry["kept"]) == (name, m["reference_settings"][name])
         assert [r["value"] for r in entry["table"]] == list(getattr(cfg.trials, name))
+        assert entry["protocol"] == cfg.trials.balance_protocol  # the balance gains' robots
+    # ... whose last kept walks, with no feedback, are the pitch gain's first candidate's
+    settled = next(r for r in log[1]["table"] if r["value"] == log[1]["kept"])
+    assert log[2]["table"][0] == {**settled, "value": 0.0}
     for entry, g in zip(log[2:], TRIAL_GAINS, strict=False):
         assert (entry["gain"], entry["channel"], entry["feature"]) == (g.name, g.channel, g.feature)
         assert entry["protocol"] == (getattr(cfg.trials, g.protocol) if g.protocol else "eval")

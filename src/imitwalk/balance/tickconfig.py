@@ -64,10 +64,12 @@ class TrialConfig:
         tilt_protocol: the protocol the tilt gain's training robots are drawn from: on
             ``servo``'s flat floors trials of a few robots rarely see what it is for
             (``slope``: ``servo``'s robots on the hard protocol's slopes).
-        balance_protocol: the protocol the balance gains' (pitch, roll, torso) training
-            robots are drawn from (a shipped name or a ``.json``): on ``eval``'s, trials
-            of a few robots see no falls under any candidate, and 07_04 keeps no roll
-            gain where the validation robots show it needs one (docs/RESULTS.md).
+        balance_protocol: the protocol the training robots of the reference's settings
+            and of the balance gains (pitch, roll, torso) are drawn from (a shipped name
+            or a ``.json``): on ``eval``'s, trials of a few robots see no falls under any
+            candidate, and 07_04 keeps no roll gain where the validation robots show it
+            needs one (docs/RESULTS.md). The settings' last kept walks, with no feedback,
+            are the pitch gain's first candidate's.
         yaw_limit_deg: the mean |yaw drift| a walk of ``heading_seconds`` may keep [deg]
             (the acceptance's 10° in 30 s), with one standard error of the trial's mean
             to spare.

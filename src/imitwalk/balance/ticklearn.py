@@ -6,14 +6,15 @@ and ends where an uninterrupted one would:
 1. **Trials** (:func:`trials`): first, with no feedback, how the reference is played:
    the fraction of the servo feedforward added to it
    (:mod:`imitwalk.retarget.feedforward`), then the load share at which its clock waits
-   before a lift-off (:class:`~imitwalk.balance.feedback.TickPolicy`); then the
-   feedback law gyro_y → ankle pitch, gyro_x → ankle roll, the torso's pitch less the
-   nominal robot's → both hip pitches (on training robots with a wider servo spread),
-   heading → turn (steering: :data:`~imitwalk.balance.channels.PHASED`), with each gain
-   chosen in turn from its candidates by trials (:class:`Trial`) on many short walks of
-   training robots: the baseline the learned law starts from. The trials walk at the top
-   scale, or lower where no candidate walked any robot there
-   (:func:`~imitwalk.balance.ticktrials.blind`).
+   before a lift-off (:class:`~imitwalk.balance.feedback.TickPolicy`), both on training
+   robots with a wider servo spread (``trials.balance_protocol``); then the feedback law,
+   one gain at a time: gyro_y → ankle pitch, gyro_x → ankle roll, the torso's pitch less
+   the nominal robot's → both hip pitches (on the same robots), that pitch → both ankle
+   pitches (on sloped floors, ``trials.tilt_protocol``), heading → turn (steering:
+   :data:`~imitwalk.balance.channels.PHASED`), each chosen from its candidates by trials
+   (:class:`Trial`) on many short walks of training robots: the baseline the learned law
+   starts from. The trials walk at the top scale, or lower where no candidate walked any
+   robot there (:func:`~imitwalk.balance.ticktrials.blind`).
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.balance.tickmodel.PhaseModel`), turn it into gains by

@@ -246,7 +246,9 @@ def _table(lr: Learner, state: TickProgress, values, walk, yaw_limit_deg=None) -
 
 def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
     """Stage 1's first choices: how the reference is played, one setting at a time, with
-    no feedback, at the trial scale. Without a task-space plan (the paper's mapping) the
+    no feedback, at the trial scale, on the balance gains' robots
+    (``trials.balance_protocol``, whose servos sag unevenly: what the feedforward is for).
+    Without a task-space plan (the paper's mapping) the
     reference is played as it is."""
     cfg = lr.cfg
     laws = [feedback_law(cfg, {})]
@@ -255,13 +257,15 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
 
         def walk(value, most, name=name):
             settings = {**state.settings, name: value}
-            return trial(lr, state, gains_key({}), laws, False, settings, most)
+            return trial(lr, state, gains_key({}), laws, False, settings, most,
+                         protocol=cfg.trials.balance_protocol)  # fmt: skip
 
         table = _table(lr, state, candidates, walk)
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
         log.append({"stage": "trials", "gain": name, "kept": kept,
-                    "scale": lr.trial_scale(state), "table": rows})  # fmt: skip
+                    "scale": lr.trial_scale(state), "protocol": cfg.trials.balance_protocol,
+                    "table": rows})  # fmt: skip
         say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
         checkpoint(lr, state, log)
 
