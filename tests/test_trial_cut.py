@@ -15,8 +15,8 @@ from hypothesis import strategies as st
 
 from imitwalk.balance import ticktrials
 from imitwalk.balance.tickconfig import TickLearnConfig, TrialConfig
-from imitwalk.balance.tickrun import TickResult, Trial
-from imitwalk.balance.ticktrials import Learner, TickProgress, best, most_falls, trial
+from imitwalk.balance.tickrun import TickResult, Trial, best, most_falls
+from imitwalk.balance.ticktrials import Learner, TickProgress, trial
 
 N = 8  # trial robots
 

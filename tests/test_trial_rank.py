@@ -5,8 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from imitwalk.balance.tickrun import TickResult, Trial
-from imitwalk.balance.ticktrials import best
+from imitwalk.balance.tickrun import TickResult, Trial, best
 
 
 def _walks(falls: int, robots: int = 8, yaw: float | tuple = 2.0, cost: float = 1.0) -> Trial:

@@ -12,8 +12,8 @@ import pytest
 
 from imitwalk.balance import ticktrials
 from imitwalk.balance.tickconfig import TickLearnConfig, TrialConfig
-from imitwalk.balance.tickrun import TickResult, Trial
-from imitwalk.balance.ticktrials import Learner, TickProgress, best, blind
+from imitwalk.balance.tickrun import TickResult, Trial, best, blind
+from imitwalk.balance.ticktrials import Learner, TickProgress
 
 N = 4  # trial robots
 SCALES = (0.3, 0.4, 0.5, 0.6)

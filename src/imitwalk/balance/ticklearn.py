@@ -14,7 +14,7 @@ and ends where an uninterrupted one would:
    :data:`~imitwalk.balance.channels.PHASED`), each chosen from its candidates by trials
    (:class:`Trial`) on many short walks of training robots: the baseline the learned law
    starts from. The trials walk at the top scale, or lower where no candidate walked any
-   robot there (:func:`~imitwalk.balance.ticktrials.blind`).
+   robot there (:func:`~imitwalk.balance.tickrun.blind`).
 2. **The paper's loop** (§5 steps 3–7, §6): from scale 0.3 up, execute on training
    robots (with exploration in a scale's first iteration), record, fit the per-tick
    model of eqs. 3–4 (:class:`~imitwalk.balance.tickmodel.PhaseModel`), turn it into gains by
@@ -42,15 +42,13 @@ from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.lqr import Costs, horizon_gains
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import PhaseModel, nominal_profile
-from imitwalk.balance.tickrun import Trial, summarize
+from imitwalk.balance.tickrun import Trial, best, most_falls, summarize
 from imitwalk.balance.tickstore import feedback_law, load_learned, save_learned, unstack_episodes
 from imitwalk.balance.ticktrials import (
     Learner,
     TickProgress,
-    best,
     checkpoint,
     gains_key,
-    most_falls,
     say_table,
     trial,
     trials,
@@ -130,7 +128,7 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
     (the law the schedule learned at the highest scale it passed) on the heading trials'
     robots: their 30 s walks are the evaluation's length, and the trial-picked law alone
     (fraction 0) has walked them already. The smallest fraction is walked first and the
-    larger ones are cut as every trial is (:func:`~imitwalk.balance.ticktrials.most_falls`):
+    larger ones are cut as every trial is (:func:`~imitwalk.balance.tickrun.most_falls`):
     where the trial-picked law alone did not fall, a larger fraction could at best tie,
     and lose on its size, so it is not walked. Measured: this saves 280 simulated seconds
     on every run whose trial-picked law did not fall, and every run keeps its law

@@ -15,7 +15,17 @@ from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.types import SimOptions
 
-__all__ = ["TickJob", "TickResult", "Trial", "WalkSummary", "run_tick_episode", "summarize"]
+__all__ = [
+    "TickJob",
+    "TickResult",
+    "Trial",
+    "WalkSummary",
+    "best",
+    "blind",
+    "most_falls",
+    "run_tick_episode",
+    "summarize",
+]
 
 
 @dataclass(frozen=True)
@@ -182,3 +192,37 @@ class Trial:
     def summary(self) -> WalkSummary:
         """:func:`summarize` of its walks."""
         return summarize(self.results)
+
+
+def best(table: list, yaw_limit_deg: float | None = None):
+    """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`)."""
+    return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
+
+
+def blind(table: list) -> bool:
+    """Whether every candidate of ``table`` (rows ``(value, Trial)``) fell on every one
+    of its planned robots: the trials could then rank them only by the time walked, which
+    at a scale no candidate can walk says little (on G1 it picked a tilt gain that fell
+    every evaluation robot at 0.3, where trials at 0.3 refuse it)."""
+    return len(table) > 1 and all(
+        t.robots is not None and len(t.results) == t.robots and t.summary().falls == t.robots
+        for _, t in table
+    )
+
+
+def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) -> int | None:
+    """The most falls a candidate ``value`` may have and still be kept, against the rows
+    ``(value, Trial)`` of ``table`` so far (``None`` for an empty table: no limit).
+
+    :meth:`Trial.rank` orders by falls first, so a candidate is out once it has fallen
+    more often than the best row. A tie loses too where the rest of the rank already
+    favours the best row: not every one of its robots fell, it kept the heading's drift
+    within ``yaw_limit_deg``, and its ``|value|`` is the smaller. Then the most is one
+    fall fewer, and against a best row with no falls the candidate is not walked at all
+    (it could at best tie, and lose on the smaller value)."""
+    if not table:
+        return None
+    v, t = best(table, yaw_limit_deg)
+    falls, drift, walked, _ = t.rank(v, yaw_limit_deg)
+    ties_lose = drift == 0.0 and walked == 0.0 and abs(value) > abs(v)
+    return falls - 1 if ties_lose else falls

@@ -8,11 +8,11 @@ feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`). A gain w
 feature is held to the nominal robot's profile first walks the nominal robot once.
 
 The trial scale is the top scale until a table cannot tell its candidates apart there:
-every candidate fell on every robot (:func:`blind`). That table is then walked again one
-scale of the schedule lower, and so on down to the schedule's first; the trials after it
-stay at the scale it ended at, and so does the trust trial. A robot that cannot walk at
-the top scale under any candidate has its gains picked where it can (G1), and one that
-can (hoap2, OP3) is never walked lower.
+every candidate fell on every robot (:func:`~imitwalk.balance.tickrun.blind`). That table
+is then walked again one scale of the schedule lower, and so on down to the schedule's
+first; the trials after it stay at the scale it ended at, and so does the trust trial. A
+robot that cannot walk at the top scale under any candidate has its gains picked where
+they can be told apart (G1, at 0.3), and one that can (hoap2, OP3) is never walked lower.
 """
 
 from __future__ import annotations
@@ -23,7 +23,15 @@ from dataclasses import asdict, dataclass, field, replace
 from imitwalk.balance.feedback import Episode
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import nominal_profile
-from imitwalk.balance.tickrun import TickJob, TickResult, Trial, run_tick_episode
+from imitwalk.balance.tickrun import (
+    TickJob,
+    TickResult,
+    Trial,
+    best,
+    blind,
+    most_falls,
+    run_tick_episode,
+)
 from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, stack_episodes
 from imitwalk.judge.protocol import RobotDraw, load_protocol
 from imitwalk.parallel import run_parallel
@@ -36,11 +44,8 @@ __all__ = [
     "REFERENCE_SETTINGS",
     "Learner",
     "TickProgress",
-    "best",
-    "blind",
     "checkpoint",
     "gains_key",
-    "most_falls",
     "profile",
     "say_table",
     "trial",
@@ -63,7 +68,7 @@ class TickProgress:
             setting name; trial: the next gain; profiles: the nominal robot's profile
             of each profiled feature, per loop tick (:func:`profile`).
         trial_scale: the scale the trials walk at (``None``: the top scale; lowered
-            where a table is :func:`blind`).
+            where a table is :func:`~imitwalk.balance.tickrun.blind`).
         scale_index, iteration: where the schedule is; passed: scales passed.
         trust: the fraction of the learned law kept (``None`` until decided).
         tried: every candidate's trial results so far, by key (run once each).
@@ -100,8 +105,8 @@ class Learner:
         return self.scales[-1] if state.trial_scale is None else state.trial_scale
 
     def lower(self, state: TickProgress, table: list) -> bool:
-        """Whether ``table`` is :func:`blind` and the trials can go one scale lower; if
-        so, they do (``state.trial_scale``)."""
+        """Whether ``table`` is :func:`~imitwalk.balance.tickrun.blind` and the trials
+        can go one scale lower; if so, they do (``state.trial_scale``)."""
         below = [s for s in self.scales if s < self.trial_scale(state) - 1e-9]
         if not below or not blind(table):
             return False
@@ -153,13 +158,14 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     checkpoint, so that a resumed run neither repeats nor re-counts them).
 
     With ``most`` (the most falls this candidate may have and still be kept,
-    :func:`most_falls`), its walks stop once it has fallen more often, and with a
-    ``most`` below 0 it is not walked at all. Every pick is the
-    same as without the cut (tested); only the cost falls. A cut trial is finished if a
-    later use of its key needs the rest. The walks already running when it was cut are
-    paid for (``sim_seconds``) but not kept, so that the trial is the same prefix of its
-    robots whatever the workers; how many were running depends on timing, so on more
-    than one worker two runs' simulated seconds differ (measured: by up to 18 walks).
+    :func:`~imitwalk.balance.tickrun.most_falls`), its walks stop once it has fallen more
+    often, and with a ``most`` below 0 it is not walked at all. Every pick is the same as
+    without the cut (tested); only the cost falls. A cut trial is finished if a
+    later use of its key needs the rest. The walks already running when it was cut end
+    at their next tick (:func:`~imitwalk.parallel.abandoned`) and are paid for
+    (``sim_seconds``) but not kept, so that the trial is the same prefix of its robots
+    whatever the workers; how far they got depends on timing, so on more than one worker
+    two runs' simulated seconds differ (measured: 1,971 and 1,981 on 07_06).
     """
     t = lr.cfg.trials
     n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
@@ -180,40 +186,6 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     return Trial(done, n)
 
 
-def best(table: list, yaw_limit_deg: float | None = None):
-    """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`)."""
-    return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
-
-
-def blind(table: list) -> bool:
-    """Whether every candidate of ``table`` (rows ``(value, Trial)``) fell on every one
-    of its planned robots: the trials could then rank them only by the time walked, which
-    at a scale no candidate can walk says little (on G1 it picked a tilt gain that fell
-    every evaluation robot at 0.3, where trials at 0.3 refuse it)."""
-    return len(table) > 1 and all(
-        t.robots is not None and len(t.results) == t.robots and t.summary().falls == t.robots
-        for _, t in table
-    )
-
-
-def most_falls(table: list, value: float, yaw_limit_deg: float | None = None) -> int | None:
-    """The most falls a candidate ``value`` may have and still be kept, against the rows
-    ``(value, Trial)`` of ``table`` so far (``None`` for an empty table: no limit).
-
-    :meth:`Trial.rank` orders by falls first, so a candidate is out once it has fallen
-    more often than the best row. A tie loses too where the rest of the rank already
-    favours the best row: not every one of its robots fell, it kept the heading's drift
-    within ``yaw_limit_deg``, and its ``|value|`` is the smaller. Then the most is one
-    fall fewer, and against a best row with no falls the candidate is not walked at all
-    (it could at best tie, and lose on the smaller value)."""
-    if not table:
-        return None
-    v, t = best(table, yaw_limit_deg)
-    falls, drift, walked, _ = t.rank(v, yaw_limit_deg)
-    ties_lose = drift == 0.0 and walked == 0.0 and abs(value) > abs(v)
-    return falls - 1 if ties_lose else falls
-
-
 def gains_key(gains: dict) -> str:
     """The trials' key of a law with ``gains`` by setting name (a missing one is 0)."""
     return ",".join(f"{g.name}={gains.get(g.name, 0.0):g}" for g in TRIAL_GAINS)
@@ -232,9 +204,9 @@ def say_table(lr: Learner, head: str, table) -> None:
 
 def _table(lr: Learner, state: TickProgress, values, walk, yaw_limit_deg=None) -> list:
     """The rows ``(value, Trial)`` of ``values``, each walked by ``walk(value, most)``
-    (``most``: :func:`most_falls` against the rows before it) at the trial scale, and
-    walked again one scale lower while the table is :func:`blind` there
-    (:meth:`Learner.lower`)."""
+    (``most``: :func:`~imitwalk.balance.tickrun.most_falls` against the rows before it) at
+    the trial scale, and walked again one scale lower while the table is
+    :func:`~imitwalk.balance.tickrun.blind` there (:meth:`Learner.lower`)."""
     while True:
         table: list[tuple[float, Trial]] = []
         for value in values:
