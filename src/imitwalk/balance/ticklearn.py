@@ -178,8 +178,9 @@ def learn_tick(
         checkpoint(lr, state, log, data)
     kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
     row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
-    trial_falls, tried = int(row["falls"]), lr.trial_scale(state)
-    reached = max([*state.passed, *([tried] if trial_falls == 0 else [])], default=lr.scales[0])
+    trial_falls, trial_scale = int(row["falls"]), lr.trial_scale(state)
+    walked = [trial_scale] if trial_falls == 0 else []
+    reached = max([*state.passed, *walked], default=lr.scales[0])
     summary = LearnSummary(
         learner="tick",
         scale_reached=reached,
@@ -188,7 +189,7 @@ def learn_tick(
         sim_seconds_used_for_learning=state.sim_seconds,
         wall_seconds_for_learning=state.wall_seconds,
         config=to_dict(config),
-        trial_scale=tried,
+        trial_scale=trial_scale,
         trial_falls=trial_falls,
         feedback_gains=state.gains,
         trust=state.trust,

@@ -220,8 +220,7 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
     """Stage 1's first choices: how the reference is played, one setting at a time, with
     no feedback, at the trial scale, on the balance gains' robots
     (``trials.balance_protocol``, whose servos sag unevenly: what the feedforward is for).
-    Without a task-space plan (the paper's mapping) the
-    reference is played as it is."""
+    Without a task-space plan (the paper's mapping) the reference is played as it is."""
     cfg = lr.cfg
     laws = [feedback_law(cfg, {})]
     for name in REFERENCE_SETTINGS[len(state.settings) :]:
