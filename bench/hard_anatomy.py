@@ -10,7 +10,8 @@ falls under one factor alone is the same robot in the whole protocol.
 
 Usage: ``python bench/hard_anatomy.py RUN [--controller learned] [--protocol hard]
 [--robots 40] [--first 300000] [--seconds 30] [--robot hoap2]``; prints JSON lines, one per protocol
-variant, then a summary.
+variant, then a summary. Where the protocol kicks, each fall's last kick before it is
+given (how long before, its size and direction), and the largest kick walked on from.
 """
 
 from __future__ import annotations
@@ -51,7 +52,26 @@ def walks(run, robot, controller: str, protocol, robots: int, first: int, second
         "fall_times_s": sorted(round(float(r.fall_time_s or 0.0), 2) for _, r in fell),
         "fell_before_first_kick": len(before),
         "distance_m": round(float(np.mean([r.distance_m for r in res])), 2),
+        **_kicks(draws, res),
     }
+
+
+def _kicks(draws, res) -> dict:
+    """The kick before each fall (seconds before it, |Δv| [m/s], direction [deg from
+    forward, + to the left]), by size, and the largest kick a robot walked on from."""
+    fatal, survived = [], []
+    for d, r in zip(draws, res, strict=True):
+        due = [k for k in d.options.pushes if not r.fell or k[0] <= (r.fall_time_s or 0.0)]
+        last = due.pop() if r.fell and due else None
+        survived += [float(np.hypot(k[1], k[2])) for k in due]
+        if last is not None:
+            t, vx, vy = last
+            fatal.append([round(float(r.fall_time_s - t), 2), round(float(np.hypot(vx, vy)), 2),
+                          round(float(np.degrees(np.arctan2(vy, vx))))])  # fmt: skip
+    if not fatal and not survived:
+        return {}
+    return {"fatal_kicks": sorted(fatal, key=lambda k: k[1]),
+            "largest_kick_survived_mps": round(max(survived, default=0.0), 2)}  # fmt: skip
 
 
 def main() -> None:
