@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from imitwalk.balance import ticktrials
@@ -101,3 +102,67 @@ def test_blind_needs_every_planned_robot_walked_and_fallen():
     assert blind([(0.0, Trial([fell] * N, N)), (0.5, Trial([fell] * N, N))])
     assert not blind([(0.0, Trial([fell] * N, N)), (0.5, Trial([fell] * (N - 1) + [up], N))])
     assert not blind([(0.0, Trial([fell] * N, N)), (0.5, Trial([], N))])  # not walked
+
+
+def _whole_learner(run_dir, monkeypatch, say) -> Learner:
+    """A learner for the whole trial stage whose walks are made up: every robot falls
+    above 0.35; at 0.3 robot ``seed`` falls without the feedforward if ``seed`` is even."""
+    from imitwalk.balance.channels import FEATURES
+    from imitwalk.balance.feedback import Episode
+    from imitwalk.config import apply_overrides
+    from imitwalk.runs import RunDir
+
+    def walk(job):
+        fell = job.scale > 0.35 or (job.feedforward == 0.0 and job.seed % 2 == 0)
+        t = 1.0 + 0.01 * (job.seed % 7) if fell else job.seconds
+        ticks = round(t / 0.01)
+        k = np.arange(ticks)
+        ep = Episode((k - 6) % 4, np.full((ticks, len(FEATURES)), 0.01), np.zeros((ticks, 4)))
+        return TickResult(job.seed, fell, t if fell else None, t, 1.0, 0.0, 0.1, ep)
+
+    monkeypatch.setattr(ticktrials, "run_tick_episode", walk)
+    protocol = SimpleNamespace(draw=lambda seed, *_: _Draw(seed))
+    monkeypatch.setattr(ticktrials, "load_protocol", lambda _name: protocol)
+    lr = object.__new__(Learner)
+    lr.cfg = apply_overrides(TickLearnConfig(), ["workers=1", "trials.robots=3",
+                                                 "trials.heading_robots=2"])  # fmt: skip
+    lr.robot, lr.ref_path, lr.scales, lr.say = None, "", (0.3, 0.4, 0.5), say
+    lr.ref = SimpleNamespace(dt=0.01, starts=np.zeros((3, 6)), loops=np.zeros((3, 4)),
+                             plan=True, sim_options=lambda: None)  # fmt: skip
+    lr.protocol, lr.rd = protocol, RunDir(run_dir)
+    lr.rd.path.mkdir()
+    return lr
+
+
+@pytest.mark.parametrize("line", [2, 3, 5, 8])
+def test_trials_interrupted_across_a_lowered_scale_resume_exactly(tmp_path, line):
+    """Cut at the ``line``-th progress line (the second is the drop to 0.3), then resumed
+    from the checkpoint: the same state and log as the trials run through."""
+    from dataclasses import asdict
+
+    with pytest.MonkeyPatch.context() as mp:
+        whole = _whole_learner(tmp_path / "whole", mp, lambda _line: None)
+        done, log = TickProgress(), []
+        ticktrials.trials(whole, done, log)
+    assert done.trial_scale == 0.3 and done.settings["feedforward"] == 0.5
+
+    lines: list = []
+
+    def cut(text):
+        lines.append(text)
+        if len(lines) == line:
+            raise KeyboardInterrupt
+
+    with pytest.MonkeyPatch.context() as mp:
+        lr = _whole_learner(tmp_path / "cut", mp, cut)
+        with pytest.raises(KeyboardInterrupt):
+            ticktrials.trials(lr, TickProgress(), [])
+        rd = lr.rd
+        saved = rd.read_json("checkpoint.json") if rd.exists("checkpoint.json") else {}
+        if line >= 5:  # cut after the settings' checkpoint: the run resumes at 0.3
+            assert saved["trial_scale"] == 0.3 and saved["settings"]
+        state, again = TickProgress(**saved), rd.read_log()
+        lr.say = lambda _line: None
+        ticktrials.trials(lr, state, again)
+    wall = {"wall_seconds": 0.0}  # the only thing that differs
+    assert {**asdict(state), **wall} == {**asdict(done), **wall} and again == log
