@@ -31,7 +31,8 @@ __all__ = ["EXECUTORS", "abandoned", "run_parallel"]
 
 EXECUTORS = ("process", "ray")
 
-#: In a pool's worker: the event its map sets once ``stop`` has held (``None`` elsewhere).
+#: In a pool's worker: its map's shared flag, set to 1 once ``stop`` has held (``None``
+#: elsewhere). A lock-free byte, since a job may read it every tick.
 _ABANDONED = None
 
 
@@ -40,7 +41,7 @@ def abandoned() -> bool:
     results before it. A long job may ask this as it goes and end early, with whatever
     partial result it has (it goes to ``spent``). Always ``False`` outside a pool's
     worker, where every job runs to its end."""
-    return _ABANDONED is not None and _ABANDONED.is_set()
+    return _ABANDONED is not None and bool(_ABANDONED.value)
 
 
 def run_parallel(
@@ -76,7 +77,7 @@ def run_parallel(
     if workers <= 1:
         return _until(jobs, fn, stop)
     ctx = multiprocessing.get_context()
-    done = ctx.Event()
+    done = ctx.RawValue("b", 0)
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
                                initargs=(done,))  # fmt: skip
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
@@ -92,12 +93,12 @@ def run_parallel(
         with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
             futures = [pool.submit(fn, j) for j in jobs[:ahead]]
         out = _until(in_order(), lambda f: f.result(), stop)
-        done.set()  # the jobs still running may end early
+        done.value = 1  # the jobs still running may end early
         ran = [f for f in futures[len(out) :] if not f.cancel()]
         if spent is not None:
             spent.extend(f.result() for f in ran)
     except BaseException:  # Ctrl-C or a failed job: drop the jobs not yet started
-        done.set()
+        done.value = 1
         for f in futures:
             f.cancel()
         pool.shutdown(wait=False, cancel_futures=True)
@@ -121,7 +122,7 @@ def _ctrl_c_held():
 
 
 def _worker_init(done) -> None:
-    """A worker keeps its map's ``done`` event (:func:`abandoned`) and ignores Ctrl-C: the
+    """A worker keeps its map's ``done`` flag (:func:`abandoned`) and ignores Ctrl-C: the
     parent cancels the jobs not yet started and the running ones end. (An idle worker
     interrupted while it waits for a job dies holding the pool's queue, and the pool then
     waits for it forever.)"""

@@ -7,12 +7,10 @@ with no feedback, how the reference is played (:data:`REFERENCE_SETTINGS`), then
 feedback law's gains (:data:`~imitwalk.balance.tickstore.TRIAL_GAINS`). A gain whose
 feature is held to the nominal robot's profile first walks the nominal robot once.
 
-The trial scale is the top scale until a table cannot tell its candidates apart there:
-every candidate fell on every robot (:func:`~imitwalk.balance.tickrun.blind`). That table
-is then walked again one scale of the schedule lower, and so on down to the schedule's
-first; the trials after it stay at the scale it ended at, and so does the trust trial. A
-robot that cannot walk at the top scale under any candidate has its gains picked where
-they can be told apart (G1, at 0.3), and one that can (hoap2, OP3) is never walked lower.
+The trial scale is the top scale until a table cannot tell its candidates apart there
+(:func:`~imitwalk.balance.tickrun.blind`); it is then walked again one scale of the
+schedule lower, down to the first, and the trials after it (the trust trial too) stay
+there. G1's trials so walk at 0.3; hoap2's and OP3's are never walked lower.
 """
 
 from __future__ import annotations
@@ -104,6 +102,10 @@ class Learner:
         """The scale the trials walk at (:attr:`TickProgress.trial_scale`)."""
         return self.scales[-1] if state.trial_scale is None else state.trial_scale
 
+    def at(self, state: TickProgress) -> str:
+        """What a trial's key adds for a lowered scale ("" at the top scale)."""
+        return "" if state.trial_scale is None else f" at {state.trial_scale:g}"
+
     def lower(self, state: TickProgress, table: list) -> bool:
         """Whether ``table`` is :func:`~imitwalk.balance.tickrun.blind` and the trials
         can go one scale lower; if so, they do (``state.trial_scale``)."""
@@ -157,22 +159,17 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     ``protocol`` (``None``: ``train_protocol``), run once per key (kept in the
     checkpoint, so that a resumed run neither repeats nor re-counts them).
 
-    With ``most`` (the most falls this candidate may have and still be kept,
-    :func:`~imitwalk.balance.tickrun.most_falls`), its walks stop once it has fallen more
-    often, and with a ``most`` below 0 it is not walked at all. Every pick is the same as
-    without the cut (tested); only the cost falls. A cut trial is finished if a
-    later use of its key needs the rest. The walks already running when it was cut end
-    at their next tick (:func:`~imitwalk.parallel.abandoned`) and are paid for
-    (``sim_seconds``) but not kept, so that the trial is the same prefix of its robots
-    whatever the workers; how far they got depends on timing, so on more than one worker
-    two runs' simulated seconds differ (measured: 1,971 and 1,981 on 07_06).
-    """
+    With ``most`` (:func:`~imitwalk.balance.tickrun.most_falls`) its walks stop once it
+    has fallen more often (below 0: not walked). Every pick is the same as without the cut
+    (tested); a cut trial is finished if a later use of its key needs the rest. Walks
+    running when it was cut end at their next tick (:func:`~imitwalk.parallel.abandoned`),
+    paid for (``sim_seconds``) but not kept: the trial is the same prefix of its robots
+    whatever the workers, its cost not (07_06: 1,971 and 1,981 simulated seconds)."""
     t = lr.cfg.trials
     n, seconds = (t.heading_robots, t.heading_seconds) if heading else (t.robots, t.seconds)
     settings = state.settings if settings is None else settings
     key += "".join(f";{k} {v:g}" for k, v in settings.items() if v)
-    key = f"{key}@{n}x{seconds:g}s" + ("" if protocol is None else f" [{protocol}]")
-    key += "" if state.trial_scale is None else f" at {state.trial_scale:g}"
+    key = f"{key}@{n}x{seconds:g}s" + ("" if protocol is None else f" [{protocol}]") + lr.at(state)
     done = [TickResult(**r) for r in state.tried.get(key, [])]
     limit = n if most is None else most
     fell = sum(r.fell for r in done)
@@ -248,8 +245,7 @@ def profile(lr: Learner, state: TickProgress, feature: str) -> None:
     start-up and, if it fell, its last half second left out (its start-up too if nothing
     else is left)."""
     cfg, ref = lr.cfg, lr.ref
-    key = f"nominal robot: {feature} profile@{cfg.trials.seconds:g}s"
-    key += "" if state.trial_scale is None else f" at {state.trial_scale:g}"
+    key = f"nominal robot: {feature} profile@{cfg.trials.seconds:g}s" + lr.at(state)
     laws = [feedback_law(cfg, state.gains, state.profiles)]
     nominal = RobotDraw(0, ref.sim_options())
     (res,) = lr.run(state, lr.trial_scale(state), laws, [nominal], cfg.trials.seconds)

@@ -249,9 +249,8 @@ def run(
         q0: ``(n,)`` starting posture [rad]; ``None``: the policy's own ``q0`` if it
             declares one (a controller starts where its trajectory starts, as open-loop
             playback of that trajectory does), else standing.
-        stop_on_fall: end the run at the first fall.
-        abandon: asked after every tick; once it holds, the run ends there (its result
-            is no longer needed: :func:`imitwalk.parallel.abandoned`).
+        stop_on_fall: end the run at the first fall; abandon: end it once this, asked
+            after every tick, holds (:func:`imitwalk.parallel.abandoned`).
     """
     if q0 is None:
         q0 = getattr(policy, "q0", None)
