@@ -26,8 +26,6 @@ and the steady loop (``e ≡ 1``), which is closed by construction.
 
 from __future__ import annotations
 
-import os
-
 from dataclasses import dataclass
 
 import numpy as np
@@ -203,16 +201,9 @@ def plan_walk(
                 yaw[i, j] = land[f][2]
                 stance[i, j] = True
     hip = params.height * geom.hip_height
-    pelvis_z = np.full(n, hip + geom.hip_z)
     if cap_scale is not None:
-        cap = knee_cap(template, geom, params, max(cap_scale, scale), start, cmd)
-        if RISE:  # a prototype: the pelvis rises where the legs allow, not at one height
-            prof = hip_profile(template, geom, params, max(cap_scale, scale), start, cmd)
-            grid = np.arange(len(prof)) / len(prof)
-            pelvis_z = np.minimum(hip, np.interp(psi, grid, prof, period=1.0)) + geom.hip_z
-        else:
-            pelvis_z = np.full(n, min(hip, cap) + geom.hip_z)
-        hip = min(hip, cap)
+        hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start, cmd))
+    pelvis_z = np.full(n, hip + geom.hip_z)
     pitch = float(np.radians(cmd.slope_deg))
     # on a slope the CoM sits over the feet along gravity: its height × tan(slope) uphill
     lean = params.lean + (hip + geom.hip_z) * np.tan(pitch)
@@ -247,35 +238,6 @@ def plan_walk(
         path=path[cut],
         motion=cycle_motion(path, n_out - n_cyc, n_cyc),
     )
-
-
-#: A prototype (IMITWALK_RISE=1): the pelvis height per phase, not one for the cycle.
-RISE = bool(int(os.environ.get("IMITWALK_RISE", "0")))
-
-
-def hip_profile(template, geom, params, scale, start=True, command=None, bins=100, width=0.1):
-    """``(bins,)`` the highest hip [m] per phase bin that keeps both knees bent
-    ``KNEE_MIN_DEG`` (as :func:`knee_cap`, but per tick and binned by phase), eroded and
-    then averaged over ±``width`` of the cycle (so it stays under the per-tick cap)."""
-    plan = plan_walk(
-        template, geom, params, scale, 0.01, cycles=1, start=start, cap_scale=None, command=command
-    )
-    reach = geom.leg * np.cos(np.radians(KNEE_MIN_DEG) / 2)
-    c, s = np.cos(plan.path[:, 2]), np.sin(plan.path[:, 2])
-    per_tick = np.full(len(plan.phase), np.inf)
-    for j, (side, sole) in enumerate(((1.0, plan.l_sole), (-1.0, plan.r_sole))):
-        hip_x = plan.com[:, 0] + c * geom.hip_ahead - s * side * geom.hip_y
-        hip_y = plan.com[:, 1] + s * geom.hip_ahead + c * side * geom.hip_y
-        dx = hip_x - (sole[:, 0] - np.cos(plan.yaw[:, j]) * geom.sole_x)
-        dy = hip_y - (sole[:, 1] - np.sin(plan.yaw[:, j]) * geom.sole_x)
-        dz2 = np.maximum(reach**2 - dx**2 - dy**2, (0.5 * geom.leg) ** 2)
-        per_tick = np.minimum(per_tick, np.sqrt(dz2) + sole[:, 2] + geom.ankle)
-    b = np.minimum((plan.phase * bins).astype(int), bins - 1)
-    low = np.full(bins, np.inf)
-    np.minimum.at(low, b, per_tick)
-    w = max(1, int(width * bins))
-    idx = (np.arange(bins)[:, None] + np.arange(-w, w + 1)[None, :]) % bins
-    return low[idx].min(axis=1)[idx].mean(axis=1)
 
 
 def knee_cap(
