@@ -1,4 +1,5 @@
-"""End-to-end: learn and evaluate on every real walk, and the demo (slow; CI runs them)."""
+"""End-to-end: learn and evaluate on every real walk (the C3D treadmill one too), and the
+demo (slow; CI runs them)."""
 
 from __future__ import annotations
 
@@ -38,7 +39,9 @@ QUICK = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("variant", ["faithful", "extended"])
-@pytest.mark.parametrize("clip", ["default", "cmu_bvh/07_04.bvh", "cmu_bvh/07_06.bvh"])
+@pytest.mark.parametrize(
+    "clip", ["default", "cmu_bvh/07_04.bvh", "cmu_bvh/07_06.bvh", "c3d/treadmill_events.c3d"]
+)
 def test_learn_and_evaluate_every_walk(shared_mocap, tmp_path, capsys, clip, variant):
     out = tmp_path / "run"
     argv = ["learn", "--out", str(out), "--variant", variant, "--json"]
