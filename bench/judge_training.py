@@ -20,19 +20,6 @@ from imitwalk.judge.verdict import judge_protocol
 from imitwalk.robots import load_robot
 
 
-class _From:
-    """``protocol`` with robot ``s`` drawn as its robot ``first + s``."""
-
-    def __init__(self, protocol, first: int):
-        self.p, self.first = protocol, first
-
-    def __getattr__(self, name):
-        return getattr(self.p, name)
-
-    def draw(self, seed, robot, base=None, seconds=30.0):
-        return self.p.draw(seed + self.first, robot, base, seconds)
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("run")
@@ -41,8 +28,8 @@ def main() -> None:
     ap.add_argument("--robots", type=int, default=40)
     ap.add_argument("--robot", default="hoap2")
     a = ap.parse_args()
-    p = _From(load_protocol(a.protocol), a.first)
-    out = judge_protocol(a.run, load_robot(a.robot), p, a.robots, 30.0, controllers=("learned",))
+    p = load_protocol(a.protocol)
+    out = judge_protocol(a.run, load_robot(a.robot), p, a.robots, 30.0, ("learned",), first=a.first)
     v = out.controllers["learned"]
     fell = [(s.seed, round(s.fall_time_s, 1)) for s in v.per_seed if s.fell]
     print(json.dumps({"first": a.first, "falls": v.falls, "robots": v.robots, "fell": fell,

@@ -7,7 +7,8 @@ plan. Prints JSON: fell, distance and the reference's expected distance [m], the
 and realised swing height (max, mean over the planned swing) [mm], and the realised
 forward advance per cycle against the planned stride [m].
 
-Usage: ``python bench/stride_realised.py REF.npz [--scale 1.0] [--seconds 30]``.
+Usage: ``python bench/stride_realised.py REF.npz [--scale 1.0] [--seconds 30] [--robot R]``
+(``--robot``: a built-in name or a joint map; default: the robot the reference records).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import json
 import mujoco
 import numpy as np
 
+from imitwalk.retarget.checks import sole_pose
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import load_robot
 from imitwalk.sim.mujoco import make_plant, playback
@@ -28,18 +30,20 @@ def main() -> None:
     ap.add_argument("reference")
     ap.add_argument("--scale", type=float, default=1.0)
     ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--robot", default=None)
     a = ap.parse_args()
     ref = Reference.load(a.reference)
+    robot = load_robot(a.robot or ref.settings.get("robot") or ref.robot)
     q = ref.trajectory(a.scale, a.seconds)
-    plant = make_plant(load_robot(ref.robot), ref.sim_options())
+    plant = make_plant(robot, ref.sim_options())
     ro = playback(plant, q, q0=q[0])
     model, data = plant.model, mujoco.MjData(plant.model)
-    soles = ("l_sole", "r_sole")
+    soles = ("l_sole", "r_sole")  # the plan's keys, left then right
     x = np.zeros((len(ro.qpos), 2, 3))
     for k, qp in enumerate(ro.qpos):
         data.qpos[:] = qp
         mujoco.mj_kinematics(model, data)
-        x[k] = [data.site(s).xpos for s in soles]
+        x[k] = [sole_pose(model, data, robot.soles[side])[0] for side in "lr"]
     plan, motion = ref.plan_at(a.scale), ref.motion_at(a.scale)
     p = np.array([[ref.plan_row(plan, motion, k)[s][:3] for s in soles] for k in range(len(ro.t))])
     stride = ref.at_scale(a.scale)[2]

@@ -74,6 +74,16 @@ def test_a_subset_of_controllers_at_another_scale(tick_run, robot):
         judge_protocol(tick_run, robot, load_protocol("eval"), 1, 2.0, ("learned", "x"))
 
 
+def test_robots_from_a_first_seed_are_judged(tick_run, robot):
+    protocol = load_protocol("eval")
+    out = judge_protocol(tick_run, robot, protocol, 1, 2.0, ("fixed",), 1.0, 1, first=300_000)
+    assert [r.seed for r in out.controllers["fixed"].per_seed] == [300_000]
+    assert out.settings.first == 300_000
+    assert protocol.draw(300_000, robot).options != protocol.draw(0, robot).options
+    with pytest.raises(ConfigError, match=r"first robot -1: valid robots are 0 and up"):
+        judge_protocol(tick_run, robot, protocol, 1, 2.0, ("fixed",), first=-1)
+
+
 def test_the_breakdown_counts_each_perturbed_robots_fall_once():
     from imitwalk.judge.verdict import RobotWalk, _side
     from imitwalk.sim.metrics import WalkMetrics

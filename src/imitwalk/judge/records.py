@@ -146,14 +146,15 @@ class ProtocolId:
 
 @dataclass(frozen=True)
 class JudgeSettings:
-    """How it was judged: robots, seconds per robot [s], engine, stride scale, and the
-    controllers asked for, in order."""
+    """How it was judged: robots, seconds per robot [s], engine, stride scale, the
+    controllers asked for, in order, and the first robot's seed."""
 
     seeds: int
     seconds: float
     engine: str
     scale: float | None
     controllers: tuple[str, ...]
+    first: int = 0
 
 
 @dataclass(frozen=True)

@@ -160,19 +160,24 @@ def judge_protocol(
     scale: float | None = None,
     workers: int | None = None,
     explain: bool = False,
+    first: int = 0,
 ) -> ProtocolVerdict:
     """Every controller in ``controllers`` (``None``: every one the run can build) on
-    robots ``0 … seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per controller,
-    and each one's falls compared with open loop's on the same robots (McNemar).
-    ``explain``: also walk each fall again once per factor, that factor at nominal
-    (:func:`~imitwalk.judge.explain.explain_falls`)."""
+    robots ``first … first + seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per
+    controller, and each one's falls compared with open loop's on the same robots
+    (McNemar). ``explain``: also walk each fall again once per factor, that factor at
+    nominal (:func:`~imitwalk.judge.explain.explain_falls`). ``first`` > 0 judges robots
+    that evaluation does not, e.g. training robots (1001 on) or validation robots (300 000
+    on)."""
+    if first < 0:
+        raise ConfigError(f"first robot {first}: valid robots are 0 and up")
     loaded = _loaded(str(run_dir))
     valid = loaded.controllers()
     controllers = valid if controllers is None else tuple(controllers)
     for c in controllers:
         if c not in valid:
             raise unknown_name("controller", c, valid, ConfigError)
-    draws = [protocol.draw(s, robot, seconds=seconds) for s in range(seeds)]
+    draws = [protocol.draw(first + s, robot, seconds=seconds) for s in range(seeds)]
     twin = {c: loaded.twin(c) for c in controllers}
     jobs = [
         JudgeJob(
@@ -209,6 +214,7 @@ def judge_protocol(
         protocol=ProtocolId(protocol.name, protocol.version, protocol.path),
         settings=JudgeSettings(
             seeds=seeds,
+            first=first,
             seconds=seconds,
             engine=protocol.engine,
             scale=scale if scale is not None else loaded.metrics.scale_reached,

@@ -9,10 +9,12 @@ import numpy as np
 
 from imitwalk.robots import Robot
 
-__all__ = ["kinematic_checks"]
+__all__ = ["kinematic_checks", "sole_pose"]
 
 
-def _sole(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+def sole_pose(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Position ``(3,)`` [m] and rotation ``(3, 3)`` of the sole ``name`` (a site, else a
+    body; :attr:`~imitwalk.robots.Robot.soles`) in ``data``, after kinematics."""
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
         i = model.site(name).id
         return data.site_xpos[i].copy(), data.site_xmat[i].reshape(3, 3).copy()
@@ -72,7 +74,7 @@ def kinematic_checks(
         d.qpos[:] = qpos[i]
         mujoco.mj_kinematics(m, d)
         for j, s in enumerate("lr"):
-            p, rmat = _sole(m, d, robot.soles[s])
+            p, rmat = sole_pose(m, d, robot.soles[s])
             pos[i, j] = p
             tilt[i, j] = np.degrees(np.arccos(np.clip(rmat[2, 2], -1.0, 1.0)))
     stance_tilt = float(tilt[stance].max()) if stance.any() else 0.0
