@@ -33,6 +33,8 @@ QUICK = {
         "seconds=8",
         "trials.robots=3",
         "trials.seconds=8",
+        "choice.robots=3",
+        "choice.seconds=10",
     ],
 }
 
@@ -50,6 +52,7 @@ def test_learn_and_evaluate_every_walk(shared_mocap, tmp_path, capsys, clip, var
     assert main(argv) == 0
     learned = json.loads(capsys.readouterr().out)
     assert learned["variant"] == variant and learned["iterations"] >= 2
+    assert ("reference_choice" in learned) == (variant == "extended")
     assert main(["evaluate", str(out), "--seconds", "10", "--seeds", "3", "--json"]) == 0
     ev = json.loads(capsys.readouterr().out)
     sides = ev["controllers"]
@@ -86,11 +89,12 @@ def test_learn_and_evaluate_on_bullet(tmp_path, capsys):
     out = tmp_path / "run"
     argv = ["learn", "--out", str(out), "--json", "--set", "engine=bullet"]
     argv += ["--set", "retarget.search_config.engine=bullet"]
-    argv += sets([*SEARCH, *TICK, "start=0.3", "step=0.1", "stop=0.4"])
+    argv += sets([*SEARCH, *TICK, "start=0.3", "step=0.1", "stop=0.4", "choice.robots=2"])
     assert main(argv) == 0
     learned = json.loads(capsys.readouterr().out)
     assert learned["iterations"] >= 2
     assert json.loads((out / "config.json").read_text())["learn"]["engine"] == "bullet"
+    assert json.loads((out / "choice.json").read_text())["kept"] in ("searched", "closed")
     argv = ["evaluate", str(out), "--seconds", "10", "--seeds", "2", "--json"]
     assert main([*argv, "--protocol", "bullet"]) == 0
     ev = json.loads(capsys.readouterr().out)

@@ -14,7 +14,7 @@ from imitwalk.errors import ConfigError
 from imitwalk.judge.protocol import load_protocol
 from imitwalk.sim.types import ENGINES
 
-__all__ = ["STATE_COSTS", "LqrConfig", "TickLearnConfig", "TrialConfig"]
+__all__ = ["STATE_COSTS", "ChoiceConfig", "LqrConfig", "TickLearnConfig", "TrialConfig"]
 
 #: The model-based law's default λ per feature [per unit²]: eq. 6's 1 on each gyro axis
 #: [(rad/s)²], and 30 on each tilt and the heading [rad²] (a 0.1 rad tilt costs as much as
@@ -171,6 +171,27 @@ class LqrConfig:
 
 
 @dataclass(frozen=True)
+class ChoiceConfig:
+    """The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.balance.refchoice`).
+
+    Attributes:
+        robots: the training robots each pass's learned controller walks (0: no second
+            pass; the open-loop search's reference is learned and kept). seconds:
+            simulated time each [s]. first: the first robot's seed, a training robot
+            (1001 … 299 999: no evaluation or validation robot).
+    """
+
+    robots: int = 40
+    seconds: float = 30.0
+    first: int = 1001
+
+    def __post_init__(self):
+        _range("choice.robots", (self.robots,), 0, 1000)
+        _range("choice.seconds", (self.seconds,), 1.0, 600.0)
+        _range("choice.first", (self.first,), 1001, 300_000 - max(self.robots, 1))
+
+
+@dataclass(frozen=True)
 class TickLearnConfig:
     """The per-tick learner (paper §5 steps 3–7 with §6's scale schedule).
 
@@ -181,7 +202,8 @@ class TickLearnConfig:
         robots: training robots per iteration; seconds: simulated time each [s].
         train_protocol: the protocol the training robots (the trials' and the
             schedule's) are drawn from, with seeds no evaluation uses.
-        trials: the trial-picked law; lqr: the model-based law.
+        trials: the trial-picked law; lqr: the model-based law; choice: the reference
+            choice of ``imitwalk learn CLIP`` (a given reference is learned as it is).
         seed: random seed; workers: processes (``None``: one per core); engine: the
             physics engine learned on.
     """
@@ -195,6 +217,7 @@ class TickLearnConfig:
     train_protocol: str = "eval"
     trials: TrialConfig = field(default_factory=TrialConfig)
     lqr: LqrConfig = field(default_factory=LqrConfig)
+    choice: ChoiceConfig = field(default_factory=ChoiceConfig)
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"

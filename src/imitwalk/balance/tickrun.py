@@ -13,6 +13,7 @@ import numpy as np
 from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
 from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
+from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
 
 __all__ = [
@@ -25,6 +26,7 @@ __all__ = [
     "most_falls",
     "run_tick_episode",
     "summarize",
+    "tick_walk_metrics",
 ]
 
 
@@ -91,15 +93,13 @@ def _reference(path: str):
     return _REFS[path]
 
 
-def run_tick_episode(job: TickJob) -> TickResult:
-    """Walk ``job``'s laws on its robot (runs in a worker process); a walk its map no
-    longer needs (:func:`~imitwalk.parallel.abandoned`) ends there, its seconds paid."""
+def _walk(job: TickJob):
+    """Walk ``job``: its reference, policy, rollout and metrics."""
+    from imitwalk.retarget.feedforward import walk_offsets
     from imitwalk.sim.metrics import walk_metrics
     from imitwalk.sim.mujoco import make_plant, run
 
     ref = _reference(job.ref_path)
-    from imitwalk.retarget.feedforward import walk_offsets
-
     offsets = walk_offsets(ref, job.robot, job.scale, job.seconds, job.feedforward)
     names = job.robot.joint_names
     policy = TickPolicy(
@@ -114,6 +114,19 @@ def run_tick_episode(job: TickJob) -> TickResult:
         policy.q_ref,
         ref.track(job.scale, ro.seconds),
     )
+    return ref, policy, ro, m
+
+
+def tick_walk_metrics(job: TickJob) -> WalkMetrics:
+    """The :class:`~imitwalk.sim.metrics.WalkMetrics` of walking ``job`` (in the calling
+    process)."""
+    return _walk(job)[3]
+
+
+def run_tick_episode(job: TickJob) -> TickResult:
+    """Walk ``job``'s laws on its robot (runs in a worker process); a walk its map no
+    longer needs (:func:`~imitwalk.parallel.abandoned`) ends there, its seconds paid."""
+    ref, policy, ro, m = _walk(job)
     walk = ro.gyro[ref.starts.shape[1] - ref.loops.shape[1] :]  # from the last start-up cycle
     cost = float(np.mean(np.sum(walk**2, axis=1))) if len(walk) else float("inf")
     return TickResult(

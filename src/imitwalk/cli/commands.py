@@ -154,7 +154,7 @@ def learn(args: argparse.Namespace) -> int:
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
-    resumed = args.resume and rd.exists("reference.npz")
+    resumed = args.resume and rd.exists("reference.npz") and not rd.exists("choice.json")
     given = args.reference or resumed
     if flags and given:
         raise ConfigError(
@@ -170,6 +170,15 @@ def learn(args: argparse.Namespace) -> int:
         progress(f"learn: resuming {rd.path}")
     elif args.reference:
         ref = Reference.load(args.reference)
+    elif args.variant != "faithful":  # the per-tick learner chooses between two references
+        from imitwalk.balance.refchoice import learn_clip
+
+        rcfg = _with_command(rcfg, args)
+        _announce_search(rcfg)
+        stamp = {"robot": _where(args.robot), "joint_map": _where(args.joint_map)}
+        summary, choice = learn_clip(_motion(args), robot, rcfg, cfg, args.out, args.resume,
+                                     stamp, progress, search_report, refine_report)  # fmt: skip
+        return _learned(summary, args, rd, choice)
     else:
         motion = _motion(args)
         progress(f"learn: retargeting {motion.source}")
@@ -182,8 +191,15 @@ def learn(args: argparse.Namespace) -> int:
         ref.settings["joint_map"] = _where(args.joint_map)
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
+    return _learned(summary, args, rd)
+
+
+def _learned(summary: LearnSummary, args: argparse.Namespace, rd, choice=None) -> int:
+    """Print a learning run's summary (and its reference choice, if it made one)."""
     out = {k: v for k, v in summary.to_dict().items() if k not in ("config", "gait")}
     out["variant"] = args.variant
+    if choice is not None:
+        out["reference_choice"] = {**choice.to_dict(), **choice.cost()}
     out["run_dir"] = str(rd.path)
     emit(out, args.json)
     return 0

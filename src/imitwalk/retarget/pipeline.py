@@ -23,7 +23,7 @@ from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.reference import Reference
 from imitwalk.retarget.refine import refine_params, refine_per_scale
-from imitwalk.retarget.search import SearchConfig, search_params
+from imitwalk.retarget.search import SearchConfig, Walker, search_params
 from imitwalk.retarget.template import GaitTemplate, extract_template
 from imitwalk.retarget.walkable import build_walkable, off_grid
 from imitwalk.robots import Robot
@@ -125,6 +125,7 @@ def retarget(
     config: RetargetConfig | None = None,
     progress=None,
     refine_progress=None,
+    walker: Walker | None = None,
 ) -> RetargetResult:
     """Retarget ``motion`` to ``robot``.
 
@@ -133,7 +134,9 @@ def retarget(
         robot: the robot.
         config: settings; progress: optional ``callback(generation, total, score, params)``
             for the parameter search; refine_progress: optional ``callback(done, total,
-            trial)`` for its refinement (``search_config.refine_rounds``).
+            trial)`` for its refinement (``search_config.refine_rounds``); walker: the
+            search walks its candidates under a controller
+            (:data:`~imitwalk.retarget.search.Walker`; ``None``: open loop).
 
     Raises:
         MocapError: the clip has no walking cycle. ConfigError: bad settings.
@@ -169,6 +172,7 @@ def retarget(
                 dt,
                 progress=progress,
                 command=cfg.command,
+                walker=walker,
             )
             if sc.refine_rounds:
                 how = refine_per_scale if sc.refine_per_scale else refine_params

@@ -6,11 +6,15 @@ double support, lean, width) are chosen by the cross-entropy method over open-lo
 rollouts: each candidate reference is solved by IK at a few stride scales and played
 on the nominal robot and on training perturbations (never an evaluation robot). A
 rollout scores ``alive fraction + ½·min(progress ratio, 1) − ½·min(|yaw drift| / 45°, 1)``.
+A ``walker`` plays each candidate under a controller instead (a learned balance law:
+:mod:`imitwalk.balance.refchoice`), with the same robots, scales and score.
 """
 
 from __future__ import annotations
 
+import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
@@ -24,12 +28,17 @@ from imitwalk.retarget.plan import GaitParams
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
-from imitwalk.sim.metrics import walk_metrics
+from imitwalk.sim.metrics import WalkMetrics, walk_metrics
 from imitwalk.sim.mujoco import SimOptions, make_plant, playback
 from imitwalk.sim.perturb import perturbed, train_seeds
 from imitwalk.sim.types import ENGINES
 
-__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "bounds", "search_params"]
+__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "Walker", "bounds", "search_params"]
+
+#: ``walker(reference_path, robot, scale, seed, options, seconds)`` plays the reference
+#: saved at ``reference_path`` [.npz] under a controller on one robot and returns its
+#: :class:`~imitwalk.sim.metrics.WalkMetrics` (it runs in the search's worker process).
+Walker = Callable[..., WalkMetrics]
 
 #: Search range of each reference parameter; the ranges of the lengths (:data:`LENGTHS`)
 #: are for a leg of :data:`~imitwalk.retarget.params.REFERENCE_LEG` (:func:`bounds`).
@@ -123,36 +132,43 @@ _IK: dict = {}
 
 
 def _trial(job) -> dict:
-    template, robot, params, cfg, dt, base, command = job
+    template, robot, params, cfg, dt, base, command, walker = job
     key = (robot.name, str(robot.mjcf))
     ik = _IK.setdefault(key, WalkIK(robot))
     build = build_walkable(template, robot, params, list(cfg.scales), dt, ik=ik, command=command)
     ref = build.reference
     base = ref.sim_options(base)
-    runs, score = [], []
-    for s in cfg.scales:
-        q = ref.trajectory(s, cfg.seconds)
-        for seed in train_seeds(cfg.models):
-            ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
-            m = walk_metrics(
-                ro, ref.expected_distance(s, ro.seconds), track=ref.track(s, ro.seconds)
-            )
-            val = (
-                ro.seconds / cfg.seconds
-                + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
-                - 0.5 * min(abs(m.yaw_drift_deg) / 45.0, 1.0)
-            )
-            score.append(val)
-            runs.append(
-                {
-                    "scale": s,
-                    "seed": seed,
-                    "fell": m.fell,
-                    "seconds": m.seconds,
-                    "progress_ratio": m.progress_ratio,
-                    "yaw_drift_deg": m.yaw_drift_deg,
-                }
-            )
+    with tempfile.TemporaryDirectory(prefix="imitwalk_search_") as tmp:
+        path = f"{tmp}/candidate.npz"
+        if walker is not None:
+            ref.save(path)
+        runs, score = [], []
+        for s in cfg.scales:
+            q = ref.trajectory(s, cfg.seconds)
+            for seed in train_seeds(cfg.models):
+                if walker is None:
+                    ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
+                    m = walk_metrics(
+                        ro, ref.expected_distance(s, ro.seconds), track=ref.track(s, ro.seconds)
+                    )
+                else:
+                    m = walker(path, robot, s, seed, perturbed(seed, base), cfg.seconds)
+                val = (
+                    m.seconds / cfg.seconds
+                    + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
+                    - 0.5 * min(abs(m.yaw_drift_deg) / 45.0, 1.0)
+                )
+                score.append(val)
+                runs.append(
+                    {
+                        "scale": s,
+                        "seed": seed,
+                        "fell": m.fell,
+                        "seconds": m.seconds,
+                        "progress_ratio": m.progress_ratio,
+                        "yaw_drift_deg": m.yaw_drift_deg,
+                    }
+                )
     return {"params": params.to_dict(), "score": float(np.mean(score)), "runs": runs}
 
 
@@ -165,9 +181,11 @@ def search_params(
     base: SimOptions | None = None,
     progress=None,
     command: GaitCommand | None = None,
+    walker: Walker | None = None,
 ) -> tuple[GaitParams, dict]:
     """Find reference parameters for ``template`` on ``robot`` (walking as ``command``
     says: a turn or sidestep is judged against its own path, a slope on its slope).
+    ``walker`` (:data:`Walker`; ``None``: open loop) walks each candidate.
 
     Returns:
         the best parameters found and a JSON-able report of every trial.
@@ -191,7 +209,7 @@ def search_params(
         cands = [
             GaitParams(**dict(zip(names, (lo + ui * (hi - lo)).tolist(), strict=True))) for ui in u
         ]
-        jobs = [(template, robot, c, cfg, dt, base, command) for c in cands]
+        jobs = [(template, robot, c, cfg, dt, base, command, walker) for c in cands]
         results = run_parallel(_trial, jobs, cfg.workers)
         scores = np.array([r["score"] for r in results])
         order = np.argsort(-scores, kind="stable")
@@ -207,7 +225,8 @@ def search_params(
     assert best is not None  # at least one generation ran
     per = len(cfg.scales) * cfg.models * cfg.seconds
     report = {
-        "method": "cross-entropy method over open-loop rollouts",
+        "method": "cross-entropy method over "
+        + ("open-loop rollouts" if walker is None else "rollouts under a learned law"),
         "config": asdict(replace(cfg, workers=None)),
         "bounds": box,
         "score": "alive fraction + 0.5*min(progress,1) - 0.5*min(|yaw|/45deg,1), mean over runs",

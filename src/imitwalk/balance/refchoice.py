@@ -1,0 +1,247 @@
+"""The reference choice of ``imitwalk learn CLIP``: search, learn, search again under the
+learned law, learn again, and keep the better of the two.
+
+The reference search (:mod:`imitwalk.retarget.search`) walks its candidates open loop,
+while the learner walks the reference it keeps under per-tick feedback. Open loop, a
+search can keep a reference that shuffles: CMU 07_04's lifts its swing foot 6–7 mm of the
+19 mm planned, and its slowest evaluation robot makes 0.78 of the reference's progress.
+Searched again with the learned law in the loop, it makes 0.94; but on the default clip
+and 07_06 that second search does much worse (15 and 12 falls of 40). So both are
+learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
+
+1. ``searched/``: the reference of the open-loop search, learned
+   (:func:`~imitwalk.balance.ticklearn.learn_tick`);
+2. ``closed/``: the same search (same start, seed, robots, scales and score), each
+   candidate walked under pass 1's trial-picked law and reference settings
+   (:class:`LawWalker`), learned again;
+3. ``choice.json``: each pass's learned controller walks ``choice.robots`` training robots
+   (:class:`~imitwalk.balance.tickconfig.ChoiceConfig`; the learner's ``train_protocol``,
+   on the engine it learned on); the pass that reached the larger
+   scale, then fell less, then kept the larger slowest progress ratio is kept (a tie keeps
+   pass 1), and its files are copied to the top of the run folder, where ``evaluate`` and
+   ``report`` read them.
+
+Every step is kept in the run folder, so ``--resume`` goes on from the last one done.
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+from imitwalk.balance.feedback import FeedbackLaw
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.ticklearn import learn_tick
+from imitwalk.balance.tickrun import TickJob, tick_walk_metrics
+from imitwalk.balance.tickstore import load_laws
+from imitwalk.errors import RunError
+from imitwalk.fileio import atomic_write
+from imitwalk.robots import Robot
+from imitwalk.runs import LearnSummary, RunDir
+from imitwalk.sim.metrics import WalkMetrics
+from imitwalk.sim.types import SimOptions
+
+__all__ = ["PASSES", "Choice", "LawWalker", "PassVerdict", "law_walker", "learn_clip", "pick"]
+
+#: The two passes, in the order they run (a tie keeps the first).
+PASSES = ("searched", "closed")
+
+
+@dataclass(frozen=True)
+class LawWalker:
+    """A reference search's walker (:data:`~imitwalk.retarget.search.Walker`): a finished
+    run's trial-picked law, with the reference settings its trials kept (the servo
+    feedforward fraction and the load share a lift-off waits for)."""
+
+    law: FeedbackLaw
+    feedforward: float = 0.0
+    wait: float = 0.0
+    engine: str = "mujoco"
+
+    def __call__(
+        self,
+        ref_path: str,
+        robot: Robot,
+        scale: float,
+        seed: int,
+        options: SimOptions,
+        seconds: float,
+    ) -> WalkMetrics:
+        job = TickJob(ref_path, robot, scale, (self.law,), seed, options, seconds,
+                      engine=self.engine, record=False, feedforward=self.feedforward,
+                      wait=self.wait)  # fmt: skip
+        return tick_walk_metrics(job)
+
+
+def law_walker(run_dir) -> LawWalker:
+    """The :class:`LawWalker` of the finished per-tick run in ``run_dir``."""
+    rd = RunDir(run_dir)
+    settings = rd.read_summary().reference_settings or {}
+    learn = rd.read_json("config.json")["learn"]
+    return LawWalker(
+        load_laws(run_dir)["feedback"][0],
+        float(settings.get("feedforward", 0.0)),
+        float(settings.get("wait", 0.0)),
+        str(learn.get("engine", "mujoco")),
+    )
+
+
+@dataclass(frozen=True)
+class PassVerdict:
+    """One pass, judged on the choice's training robots.
+
+    Attributes:
+        name: the pass (:data:`PASSES`); scale: the scale its learning reached and it was
+        walked at; falls, robots: counts; progress_min: the slowest robot's progress ratio;
+        distance_m: mean forward distance [m]; walked_s: simulated time walked [s];
+        learn_sim_seconds, learn_wall_seconds: its learning's cost [s]; search_sim_seconds:
+        its reference search's simulated time [s].
+    """
+
+    name: str
+    scale: float
+    falls: int
+    robots: int
+    progress_min: float
+    distance_m: float
+    walked_s: float
+    learn_sim_seconds: float
+    learn_wall_seconds: float
+    search_sim_seconds: float
+
+    def rank(self) -> tuple:
+        """The order passes are kept in (least first)."""
+        return (-self.scale, self.falls, -self.progress_min)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The reference choice: the pass ``kept`` and every pass's verdict (``choice.json``)."""
+
+    kept: str
+    passes: tuple[PassVerdict, ...]
+
+    def to_dict(self) -> dict:
+        return {"kept": self.kept, "passes": [asdict(p) for p in self.passes]}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Choice:
+        return cls(d["kept"], tuple(PassVerdict(**p) for p in d["passes"]))
+
+    def cost(self) -> dict:
+        """Simulated seconds [s] by what spent them: the kept pass's learning, and the
+        choice (the other pass's search and learning, every pass's judgement)."""
+        kept = next(p for p in self.passes if p.name == self.kept)
+        other = sum(p.learn_sim_seconds for p in self.passes) - kept.learn_sim_seconds
+        return {
+            "learning_sim_seconds": kept.learn_sim_seconds,
+            "choice_sim_seconds": other
+            + sum(p.walked_s for p in self.passes)
+            + sum(p.search_sim_seconds for p in self.passes[1:]),
+        }
+
+
+def pick(verdicts: list[PassVerdict]) -> str:
+    """The pass kept: the larger scale reached, then the fewer falls, then the larger
+    slowest progress ratio; a tie keeps the earlier pass."""
+    return min(verdicts, key=PassVerdict.rank).name
+
+
+def learn_clip(
+    motion, robot: Robot, rcfg, cfg: TickLearnConfig, run_dir, resume: bool = False,
+    stamp: dict | None = None, progress=None, search_progress=None, refine_progress=None,
+) -> tuple[LearnSummary, Choice | None]:  # fmt: skip
+    """Retarget ``motion`` (a :class:`~imitwalk.mocap.motion.Motion`) to ``robot`` with
+    ``rcfg`` (a :class:`~imitwalk.retarget.RetargetConfig`), learn, and choose between the
+    two passes (module docstring) into ``run_dir``. ``stamp`` is added to both references'
+    settings (the robot's file, as ``retarget`` records it).
+
+    Returns:
+        the kept run's summary (``metrics.json`` at the top of ``run_dir``) and the choice
+        (``None`` with ``cfg.choice.robots == 0``: pass 1 is learned in ``run_dir`` itself).
+
+    Raises:
+        RunError: ``run_dir`` holds a run and ``resume`` is off.
+    """
+    from imitwalk.retarget import Reference
+    from imitwalk.retarget import retarget as do_retarget
+
+    say = progress or (lambda _s: None)
+    root = RunDir(run_dir)
+    if cfg.choice.robots == 0:
+        resumed = resume and root.exists("reference.npz")
+        ref = Reference.load(root.file("reference.npz")) if resumed else None
+        if ref is None:
+            ref = _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress,
+                            refine_progress, None)  # fmt: skip
+        return learn_tick(ref, robot, cfg, run_dir, resume=resumed, progress=say), None
+    if not resume and (root.exists("checkpoint.json") or root.exists(PASSES[0])):
+        raise RunError(f"{root.path} already holds a run; pass --resume or choose another --out")
+    if resume and root.exists("choice.json") and root.exists("metrics.json"):
+        say(f"learn: {root.path} is finished")
+        return root.read_summary(), Choice.from_dict(root.read_json("choice.json"))
+    summaries, walker = {}, None
+    for i, name in enumerate(PASSES):
+        rd = RunDir(root.file(name))
+        how = "the open-loop search" if walker is None else "the search under pass 1's law"
+        say(f"learn: pass {i + 1} of {len(PASSES)} ({name}): {how}")
+        if rd.exists("reference.npz"):
+            ref = Reference.load(rd.file("reference.npz"))
+        else:
+            ref = _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress,
+                            refine_progress, walker)  # fmt: skip
+        go_on = rd.exists("checkpoint.json")
+        summaries[name] = learn_tick(ref, robot, cfg, rd.path, resume=go_on, progress=say)
+        walker = law_walker(rd.path)
+    choice = _judge(root, robot, cfg, summaries, say)
+    _keep(root, choice.kept)
+    root.write_json("choice.json", choice.to_dict())
+    return summaries[choice.kept], choice
+
+
+def _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress, refine_progress,
+              walker):  # fmt: skip
+    say(f"learn: retargeting {motion.source}")
+    res = do_retarget(motion, robot, rcfg, search_progress, refine_progress, walker=walker)
+    say(f"  cycles: {res.template.meta['cycles_report']}")
+    res.reference.settings.update(stamp or {})
+    return res.reference
+
+
+def _judge(root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, say) -> Choice:
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.retarget import Reference
+
+    c = cfg.choice
+    protocol = replace(load_protocol(cfg.train_protocol), engine=cfg.engine)  # learned there
+    say(f"learn: judging both passes on {c.robots} training robots x {c.seconds:g} s")
+    out = []
+    for name in PASSES:
+        path = root.file(name)
+        v = judge_protocol(path, robot, protocol, c.robots, c.seconds, ("learned",),
+                           workers=cfg.workers, first=c.first)  # fmt: skip
+        cv, s = v.controllers["learned"], summaries[name]
+        search = Reference.load(Path(path) / "reference.npz").search or {}
+        walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
+        out.append(PassVerdict(
+            name, float(s.scale_reached), cv.falls, cv.robots,
+            float(cv.progress_ratio_min or 0.0), float(cv.distance_m or 0.0), float(walked),
+            s.sim_seconds_used_for_learning, s.wall_seconds_for_learning,
+            float(search.get("sim_seconds", 0.0)),
+        ))  # fmt: skip
+        say(f"  {name}: {cv.falls} of {cv.robots} fell, slowest progress "
+            f"{cv.progress_ratio_min or 0.0:.2f}")  # fmt: skip
+    kept = pick(out)
+    say(f"learn: keeping pass {kept}")
+    return Choice(kept, tuple(out))
+
+
+def _keep(root: RunDir, name: str) -> None:
+    """Copy the kept pass's files to the top of ``root``, ``metrics.json`` last."""
+    src = Path(root.file(name))
+    files = sorted((p for p in src.iterdir() if p.is_file() and not p.name.startswith(".")),
+                   key=lambda p: p.name == "metrics.json")  # fmt: skip
+    for p in files:
+        atomic_write(root.file(p.name), lambda tmp, p=p: shutil.copyfile(p, tmp))

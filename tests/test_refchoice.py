@@ -1,0 +1,118 @@
+"""The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.balance.refchoice`):
+the rule that keeps a pass, the walker the second search plays its candidates with, and
+the run folder the whole choice writes and resumes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from conftest import sets
+from imitwalk.balance.refchoice import PASSES, Choice, PassVerdict, law_walker, pick
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.cli.main import main
+from imitwalk.config import apply_overrides
+from imitwalk.errors import ConfigError
+from imitwalk.retarget import Reference
+from imitwalk.retarget.search import SearchConfig, search_params
+from imitwalk.retarget.template import extract_template
+from imitwalk.runs import RunDir
+
+
+def _verdict(name: str, scale=1.0, falls=0, progress=0.9) -> PassVerdict:
+    return PassVerdict(name, scale, falls, 40, progress, 5.0, 1200.0, 1300.0, 20.0, 640.0)
+
+
+verdicts = st.tuples(
+    st.sampled_from([0.8, 0.9, 1.0]),
+    st.integers(0, 40),
+    st.floats(0.0, 1.2, allow_nan=False),
+)
+
+
+@given(verdicts, verdicts)
+def test_pick_keeps_the_larger_scale_then_fewer_falls_then_faster(a, b):
+    first, second = _verdict(PASSES[0], *a), _verdict(PASSES[1], *b)
+    kept = pick([first, second])
+    if a == b:
+        assert kept == PASSES[0]  # a tie keeps the open-loop search's reference
+    elif a[0] != b[0]:
+        assert kept == (PASSES[0] if a[0] > b[0] else PASSES[1])
+    elif a[1] != b[1]:
+        assert kept == (PASSES[0] if a[1] < b[1] else PASSES[1])
+    else:
+        assert kept == (PASSES[0] if a[2] >= b[2] else PASSES[1])
+
+
+def test_the_choice_round_trips_and_counts_its_own_cost():
+    c = Choice(PASSES[1], (_verdict(PASSES[0]), _verdict(PASSES[1])))
+    assert Choice.from_dict(json.loads(json.dumps(c.to_dict()))) == c
+    # the kept pass's learning, and the rest: the other learning, both judgements, one search
+    assert c.cost() == {"learning_sim_seconds": 1300.0, "choice_sim_seconds": 1300 + 2400 + 640}
+
+
+@pytest.mark.parametrize(
+    "setting", ["choice.robots=-1", "choice.first=5", "choice.first=299990", "choice.seconds=0"]
+)
+def test_choice_settings_out_of_range_are_one_line_errors(setting):
+    with pytest.raises(ConfigError, match="choice"):
+        apply_overrides(TickLearnConfig(), [setting])
+
+
+def _stub_walker(ref_path, robot, scale, seed, options, seconds):
+    """A walker that checks its candidate was saved, and walks half the time forward."""
+    assert Path(ref_path).is_file()
+    return SimpleNamespace(fell=True, seconds=seconds / 2, progress_ratio=0.4, yaw_drift_deg=9.0)
+
+
+def test_the_search_scores_the_walkers_walks(robot):
+    from imitwalk.mocap import default_clip, load_motion
+
+    template = extract_template(load_motion(default_clip()), allow_turn=False)
+    cfg = SearchConfig(
+        generations=1, population=1, elites=1, scales=(0.5,), models=2, seconds=2.0, workers=1
+    )
+    _, rep = search_params(template, robot, cfg, walker=_stub_walker)
+    assert rep["best"]["score"] == pytest.approx(0.5 + 0.5 * 0.4 - 0.5 * 9 / 45)
+    assert [r["fell"] for r in rep["best"]["runs"]] == [True, True]
+    assert "learned law" in rep["method"]
+
+
+QUICK_SEARCH = ["retarget.search_config.generations=1", "retarget.search_config.elites=1",
+                "retarget.search_config.population=2", "retarget.search_config.models=1",
+                "retarget.search_config.seconds=4", "retarget.scales=0.9,1.0"]  # fmt: skip
+QUICK_LEARN = ["start=0.9", "step=0.1", "iterations=1", "robots=2", "seconds=4",
+               "trials.robots=2", "trials.seconds=4", "trials.heading_robots=1",
+               "trials.heading_seconds=4", "choice.robots=2", "choice.seconds=5",
+               "workers=1"]  # fmt: skip
+
+
+def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, capsys):
+    out = tmp_path / "run"
+    argv = ["learn", "--out", str(out), "--json", *sets([*QUICK_SEARCH, *QUICK_LEARN])]
+    assert main(argv) == 0
+    printed = json.loads(capsys.readouterr().out)
+    choice = RunDir(out).read_json("choice.json")
+    kept = choice["kept"]
+    assert printed["reference_choice"]["kept"] == kept and kept in PASSES
+    assert [p["name"] for p in choice["passes"]] == list(PASSES)
+    assert all(p["robots"] == 2 for p in choice["passes"])
+    for name in ("metrics.json", "checkpoint.json", "reference.npz", "learned.npz"):
+        if (out / kept / name).exists():
+            assert (out / name).read_bytes() == (out / kept / name).read_bytes(), name
+    assert "learned law" in Reference.load(out / "closed" / "reference.npz").search["method"]
+    config = json.loads((out / "config.json").read_text())
+    assert config["learn"]["choice"] == {"robots": 2, "seconds": 5.0, "first": 1001}
+    walker = law_walker(out / PASSES[0])
+    assert walker.engine == "mujoco" and walker.law.channels
+    # a finished choice resumes to the same summary; a fresh start there is refused
+    assert main([*argv, "--resume"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["reference_choice"] == printed["reference_choice"]
+    assert main(argv) == 2
+    assert "already holds a run" in capsys.readouterr().err
