@@ -116,3 +116,26 @@ def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, caps
     assert again["reference_choice"] == printed["reference_choice"]
     assert main(argv) == 2
     assert "already holds a run" in capsys.readouterr().err
+
+
+def _no_wall(choice: dict) -> dict:
+    walls = ("learn_wall_seconds", "wall_seconds_for_learning")
+    return {**choice, "passes": [{k: v for k, v in p.items() if k not in walls}
+                                 for p in choice["passes"]]}  # fmt: skip
+
+
+def test_an_interrupted_choice_resumes_to_the_same_choice(tmp_path, capsys):
+    out = tmp_path / "run"
+    argv = ["learn", "--out", str(out), "--json", *sets([*QUICK_SEARCH, *QUICK_LEARN])]
+    assert main(argv) == 0
+    whole = json.loads(capsys.readouterr().out)["reference_choice"]
+    # stopped in pass 2's learning, before the choice: its checkpoint kept, the rest gone
+    for name in ("choice.json", "metrics.json", "checkpoint.json", "reference.npz"):
+        (out / name).unlink()
+    (out / "closed" / "metrics.json").unlink()
+    assert main([*argv, "--resume"]) == 0
+    again = json.loads(capsys.readouterr().out)["reference_choice"]
+    assert _no_wall(again) == _no_wall(whole)
+    assert (out / "reference.npz").read_bytes() == (
+        out / again["kept"] / "reference.npz"
+    ).read_bytes()

@@ -47,6 +47,7 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "TickLearnConfig": "imitwalk.balance.tickconfig",
     "learn_tick": "imitwalk.balance.ticklearn",
     "learn": ("imitwalk.balance.ticklearn", "learn_tick"),
+    "learn_clip": "imitwalk.balance.refchoice",
     "load_run": "imitwalk.judge.replay",
     "evaluate_run": ("imitwalk.judge.verdict", "judge_protocol"),
     "Plant": "imitwalk.sim.mujoco",

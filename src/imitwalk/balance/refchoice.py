@@ -176,7 +176,7 @@ def learn_clip(
             ref = _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress,
                             refine_progress, None)  # fmt: skip
         return learn_tick(ref, robot, cfg, run_dir, resume=resumed, progress=say), None
-    if not resume and (root.exists("checkpoint.json") or root.exists(PASSES[0])):
+    if not resume and (root.exists("checkpoint.json") or root.file(PASSES[0]).is_dir()):
         raise RunError(f"{root.path} already holds a run; pass --resume or choose another --out")
     if resume and root.exists("choice.json") and root.exists("metrics.json"):
         say(f"learn: {root.path} is finished")

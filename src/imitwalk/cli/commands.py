@@ -154,7 +154,8 @@ def learn(args: argparse.Namespace) -> int:
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
-    resumed = args.resume and rd.exists("reference.npz") and not rd.exists("choice.json")
+    # a run that chose its reference resumes as it started: the same clip, flags and settings
+    resumed = args.resume and rd.exists("reference.npz") and not rd.file("searched").is_dir()
     given = args.reference or resumed
     if flags and given:
         raise ConfigError(
