@@ -84,6 +84,19 @@ def test_robots_from_a_first_seed_are_judged(tick_run, robot):
         judge_protocol(tick_run, robot, protocol, 1, 2.0, ("fixed",), first=-1)
 
 
+def test_judging_stops_once_more_robots_fell_than_allowed(tick_run, robot):
+    hard = load_protocol("hard")
+    whole = judge_protocol(tick_run, robot, hard, 4, 4.0, ("fixed",), 1.0, 1)
+    fell = [r.fell for r in whole.controllers["fixed"].per_seed]
+    assert any(fell)  # hard's kicked robots fall within 4 s without the learned law
+    cut = judge_protocol(tick_run, robot, hard, 4, 4.0, ("fixed",), 1.0, 1, most_falls=0)
+    rows = cut.controllers["fixed"].per_seed
+    assert rows == whole.controllers["fixed"].per_seed[: fell.index(True) + 1]
+    assert cut.controllers["fixed"].falls == 1 and cut.settings.seeds == 4
+    with pytest.raises(ConfigError, match="most_falls needs one controller, not 2"):
+        judge_protocol(tick_run, robot, hard, 1, 2.0, ("fixed", "learned"), most_falls=0)
+
+
 def test_the_breakdown_counts_each_perturbed_robots_fall_once():
     from imitwalk.judge.verdict import RobotWalk, _side
     from imitwalk.sim.metrics import WalkMetrics

@@ -6,7 +6,7 @@ while the learner walks the reference it keeps under per-tick feedback. Open loo
 search can keep a reference that shuffles: CMU 07_04's lifts its swing foot 6–7 mm of the
 19 mm planned, and its slowest evaluation robot makes 0.78 of the reference's progress.
 Searched again with the learned law in the loop, it makes 0.94; but on the default clip
-and 07_06 that second search does much worse (15 and 12 falls of 40). So both are
+and 07_06 that second search does much worse (15 and 12 of 40 eval robots fall). So both are
 learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
 
 1. ``searched/``: the reference of the open-loop search, learned
@@ -16,10 +16,11 @@ learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
    (:class:`LawWalker`), learned again;
 3. ``choice.json``: each pass's learned controller walks ``choice.robots`` training robots
    (:class:`~imitwalk.balance.tickconfig.ChoiceConfig`; the learner's ``train_protocol``,
-   on the engine it learned on); the pass that reached the larger
-   scale, then fell less, then kept the larger slowest progress ratio is kept (a tie keeps
-   pass 1), and its files are copied to the top of the run folder, where ``evaluate`` and
-   ``report`` read them.
+   on the engine it learned on). The pass that reached the larger scale, then fell less,
+   then kept the larger slowest progress ratio is kept; a tie keeps pass 1. Pass 2 stops
+   walking once it has fallen more often than pass 1 at the same scale, where it can no
+   longer be kept. The kept pass's files are copied to the top of the run folder, where
+   ``evaluate`` and ``report`` read them.
 
 Every step is kept in the run folder, so ``--resume`` goes on from the last one done.
 """
@@ -217,12 +218,15 @@ def _judge(root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, sa
     c = cfg.choice
     protocol = replace(load_protocol(cfg.train_protocol), engine=cfg.engine)  # learned there
     say(f"learn: judging both passes on {c.robots} training robots x {c.seconds:g} s")
-    out = []
+    out: list[PassVerdict] = []
     for name in PASSES:
-        path = root.file(name)
+        path, s = root.file(name), summaries[name]
+        # at pass 1's scale, a pass that has fallen more often can no longer be kept
+        tie = out and s.scale_reached == out[0].scale
         v = judge_protocol(path, robot, protocol, c.robots, c.seconds, ("learned",),
-                           workers=cfg.workers, first=c.first)  # fmt: skip
-        cv, s = v.controllers["learned"], summaries[name]
+                           workers=cfg.workers, first=c.first,
+                           most_falls=out[0].falls if tie else None)  # fmt: skip
+        cv = v.controllers["learned"]
         search = Reference.load(Path(path) / "reference.npz").search or {}
         walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
         out.append(PassVerdict(
@@ -231,8 +235,9 @@ def _judge(root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, sa
             s.sim_seconds_used_for_learning, s.wall_seconds_for_learning,
             float(search.get("sim_seconds", 0.0)),
         ))  # fmt: skip
+        cut = f" (stopped: more falls than {PASSES[0]})" if cv.robots < c.robots else ""
         say(f"  {name}: {cv.falls} of {cv.robots} fell, slowest progress "
-            f"{cv.progress_ratio_min or 0.0:.2f}")  # fmt: skip
+            f"{cv.progress_ratio_min or 0.0:.2f}{cut}")  # fmt: skip
     kept = pick(out)
     say(f"learn: keeping pass {kept}")
     return Choice(kept, tuple(out))

@@ -161,6 +161,7 @@ def judge_protocol(
     workers: int | None = None,
     explain: bool = False,
     first: int = 0,
+    most_falls: int | None = None,
 ) -> ProtocolVerdict:
     """Every controller in ``controllers`` (``None``: every one the run can build) on
     robots ``first … first + seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per
@@ -168,7 +169,8 @@ def judge_protocol(
     (McNemar). ``explain``: also walk each fall again once per factor, that factor at
     nominal (:func:`~imitwalk.judge.explain.explain_falls`). ``first`` > 0 judges robots
     that evaluation does not, e.g. training robots (1001 on) or validation robots (300 000
-    on)."""
+    on). ``most_falls`` (one controller only): stop once more robots than that fell; the
+    verdict is then on the robots walked, in seed order (fewer than ``seeds``)."""
     if first < 0:
         raise ConfigError(f"first robot {first}: valid robots are 0 and up")
     loaded = _loaded(str(run_dir))
@@ -194,7 +196,13 @@ def judge_protocol(
         for c in dict.fromkeys(twin.values())  # exact copies walk once
         for d in draws
     ]
-    res = run_parallel(run_controller, jobs, workers)
+    stop = None
+    if most_falls is not None:
+        if len(controllers) != 1:
+            raise ConfigError(f"most_falls needs one controller, not {len(controllers)}")
+        stop = lambda done: sum(r.metrics.fell for r in done) > most_falls  # noqa: E731
+    res = run_parallel(run_controller, jobs, workers, stop=stop)
+    jobs = jobs[: len(res)]  # the robots walked
     by = {
         c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
         for c in controllers
