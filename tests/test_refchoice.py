@@ -139,3 +139,18 @@ def test_an_interrupted_choice_resumes_to_the_same_choice(tmp_path, capsys):
     assert (out / "reference.npz").read_bytes() == (
         out / again["kept"] / "reference.npz"
     ).read_bytes()
+
+
+def test_a_reference_not_searched_is_learned_once(tmp_path, capsys):
+    out = tmp_path / "run"
+    argv = [
+        "learn",
+        "--out",
+        str(out),
+        "--json",
+        *sets(["retarget.search=false", "retarget.scales=0.9,1.0"]),
+    ]
+    assert main([*argv, *sets(QUICK_LEARN)]) == 0
+    assert "reference_choice" not in json.loads(capsys.readouterr().out)
+    assert not (out / PASSES[0]).exists() and not (out / "choice.json").exists()
+    assert (out / "metrics.json").is_file()

@@ -132,7 +132,7 @@ class Choice:
 
     def cost(self) -> dict:
         """Simulated seconds [s] by what spent them: the kept pass's learning, and the
-        choice (the other pass's search and learning, every pass's judgement)."""
+        choice (pass 2's search, the other pass's learning, every pass's judgement)."""
         kept = next(p for p in self.passes if p.name == self.kept)
         other = sum(p.learn_sim_seconds for p in self.passes) - kept.learn_sim_seconds
         return {
@@ -160,22 +160,22 @@ def learn_clip(
 
     Returns:
         the kept run's summary (``metrics.json`` at the top of ``run_dir``) and the choice
-        (``None`` with ``cfg.choice.robots == 0``: pass 1 is learned in ``run_dir`` itself).
+        (``None`` with ``cfg.choice.robots == 0``, or where ``rcfg`` runs no search: pass 1
+        is learned in ``run_dir`` itself).
 
     Raises:
         RunError: ``run_dir`` holds a run and ``resume`` is off.
     """
     from imitwalk.retarget import Reference
-    from imitwalk.retarget import retarget as do_retarget
 
     say = progress or (lambda _s: None)
     root = RunDir(run_dir)
-    if cfg.choice.robots == 0:
+    reports = (search_progress, refine_progress)
+    if cfg.choice.robots == 0 or not rcfg.search or rcfg.mapping != "walkable":
         resumed = resume and root.exists("reference.npz")
         ref = Reference.load(root.file("reference.npz")) if resumed else None
         if ref is None:
-            ref = _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress,
-                            refine_progress, None)  # fmt: skip
+            ref = _retarget(motion, robot, rcfg, stamp, say, reports, None)
         return learn_tick(ref, robot, cfg, run_dir, resume=resumed, progress=say), None
     if not resume and (root.exists("checkpoint.json") or root.file(PASSES[0]).is_dir()):
         raise RunError(f"{root.path} already holds a run; pass --resume or choose another --out")
@@ -190,8 +190,7 @@ def learn_clip(
         if rd.exists("reference.npz"):
             ref = Reference.load(rd.file("reference.npz"))
         else:
-            ref = _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress,
-                            refine_progress, walker)  # fmt: skip
+            ref = _retarget(motion, robot, rcfg, stamp, say, reports, walker)
         go_on = rd.exists("checkpoint.json")
         summaries[name] = learn_tick(ref, robot, cfg, rd.path, resume=go_on, progress=say)
         walker = law_walker(rd.path)
@@ -201,10 +200,11 @@ def learn_clip(
     return summaries[choice.kept], choice
 
 
-def _retarget(do_retarget, motion, robot, rcfg, stamp, say, search_progress, refine_progress,
-              walker):  # fmt: skip
+def _retarget(motion, robot, rcfg, stamp, say, reports, walker):
+    from imitwalk.retarget import retarget
+
     say(f"learn: retargeting {motion.source}")
-    res = do_retarget(motion, robot, rcfg, search_progress, refine_progress, walker=walker)
+    res = retarget(motion, robot, rcfg, *reports, walker=walker)
     say(f"  cycles: {res.template.meta['cycles_report']}")
     res.reference.settings.update(stamp or {})
     return res.reference

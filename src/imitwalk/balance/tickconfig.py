@@ -176,7 +176,8 @@ class ChoiceConfig:
 
     Attributes:
         robots: the training robots each pass's learned controller walks (0: no second
-            pass; the open-loop search's reference is learned and kept). seconds:
+            pass; the open-loop search's reference is learned and kept, as where the
+            reference is not searched at all). seconds:
             simulated time each [s]. first: the first robot's seed, a training robot
             (1001 … 299 999: no evaluation or validation robot).
     """
