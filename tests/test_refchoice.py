@@ -5,6 +5,7 @@ the run folder the whole choice writes and resumes."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -47,6 +48,12 @@ def test_pick_keeps_the_larger_scale_then_fewer_falls_then_faster(a, b):
         assert kept == (PASSES[0] if a[1] < b[1] else PASSES[1])
     else:
         assert kept == (PASSES[0] if a[2] >= b[2] else PASSES[1])
+
+
+def test_where_every_robot_fell_the_longer_walk_is_kept():
+    first = replace(_verdict(PASSES[0], falls=40, progress=0.5), walked_s=80.0)
+    second = replace(_verdict(PASSES[1], falls=40, progress=-3.0), walked_s=90.0)
+    assert pick([first, second]) == PASSES[1]
 
 
 def test_the_choice_round_trips_and_counts_its_own_cost():

@@ -16,8 +16,9 @@ learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
    (:class:`LawWalker`), learned again;
 3. ``choice.json``: each pass's learned controller walks ``choice.robots`` training robots
    (:class:`~imitwalk.balance.tickconfig.ChoiceConfig`; the learner's ``train_protocol``,
-   on the engine it learned on). The pass that reached the larger scale, then fell less,
-   then kept the larger slowest progress ratio is kept; a tie keeps pass 1. Pass 2 stops
+   on the engine it learned on). The pass that reached the larger scale, then fell less
+   (where every robot fell, walked longer), then kept the larger slowest progress ratio
+   is kept; a tie keeps pass 1. Pass 2 stops
    walking once it has fallen more often than pass 1 at the same scale, where it can no
    longer be kept. The kept pass's files are copied to the top of the run folder, where
    ``evaluate`` and ``report`` read them.
@@ -112,8 +113,11 @@ class PassVerdict:
     search_sim_seconds: float
 
     def rank(self) -> tuple:
-        """The order passes are kept in (least first)."""
-        return (-self.scale, self.falls, -self.progress_min)
+        """The order passes are kept in (least first): the larger scale, the fewer falls;
+        where every robot fell, the longer walked (as the trials rank, where a progress
+        ratio says little); then the larger slowest progress ratio."""
+        walked = -self.walked_s if self.falls == self.robots else 0.0
+        return (-self.scale, self.falls, walked, -self.progress_min)
 
 
 @dataclass(frozen=True)
@@ -144,8 +148,7 @@ class Choice:
 
 
 def pick(verdicts: list[PassVerdict]) -> str:
-    """The pass kept: the larger scale reached, then the fewer falls, then the larger
-    slowest progress ratio; a tie keeps the earlier pass."""
+    """The pass kept (:meth:`PassVerdict.rank`); a tie keeps the earlier pass."""
     return min(verdicts, key=PassVerdict.rank).name
 
 
