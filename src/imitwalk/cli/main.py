@@ -134,11 +134,17 @@ def build_parser() -> argparse.ArgumentParser:
     _engine_arg(pb, "mujoco", "mujoco")
     pb.add_argument("--json", action="store_true", help="print JSON")
     pb.set_defaults(func=commands.playback)
-    ln = sub.add_parser("learn", help="learn to walk a mocap clip (retargets it first)")
+    ln = sub.add_parser(
+        "learn",
+        help="learn to walk a mocap clip: retarget, learn, search the reference again under "
+        "the learned law, learn again, keep the better on 40 training robots (extended)",
+    )
     _mocap_args(ln)
     _robot_args(ln, positional=False)
     ln.add_argument("--out", required=True, help="run folder")
-    ln.add_argument("--reference", help="a .npz from retarget (skip retargeting)")
+    ln.add_argument(
+        "--reference", help="a .npz from retarget, learned as it is (no search, no choice)"
+    )
     ln.add_argument(
         "--variant",
         default="extended",
