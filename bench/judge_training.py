@@ -1,8 +1,8 @@
 """A run's learned controller judged on one protocol's robots from seed ``FIRST`` on.
 
 ``imitwalk evaluate`` judges robots 0 … N − 1; this walks ``FIRST`` … ``FIRST + N − 1``
-instead: training robots (``--first 1001``, the default) to choose between two runs'
-references without touching eval's or validation's robots, or validation robots
+instead: training robots (``--first 1001``, the default; ``imitwalk learn CLIP`` judges
+its two references there itself, :mod:`imitwalk.balance.refchoice`) or validation robots
 (``--first 300000``). It prints JSON: the falls, each fall's seed and time [s], the
 slowest robot's progress ratio and the mean forward distance [m].
 

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
-from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
@@ -14,7 +13,14 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from conftest import sets
-from imitwalk.balance.refchoice import PASSES, Choice, PassVerdict, law_walker, pick
+from imitwalk.balance.refchoice import (
+    PASSES,
+    Choice,
+    PassVerdict,
+    law_walker,
+    learn_clip,
+    pick,
+)
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
@@ -71,9 +77,15 @@ def test_choice_settings_out_of_range_are_one_line_errors(setting):
         apply_overrides(TickLearnConfig(), [setting])
 
 
-def _stub_walker(ref_path, robot, scale, seed, options, seconds):
-    """A walker that checks its candidate was saved, and walks half the time forward."""
-    assert Path(ref_path).is_file()
+def test_no_choice_to_make_is_refused(robot, tmp_path):
+    cfg = apply_overrides(TickLearnConfig(), ["choice.robots=0"])
+    with pytest.raises(ConfigError, match=r"choice\.robots is 0"):
+        learn_clip(lambda walker: None, robot, cfg, tmp_path / "run")
+
+
+def _stub_walker(ref, robot, scale, seed, options, seconds):
+    """A walker that checks it is given the candidate, and walks half the time forward."""
+    assert isinstance(ref, Reference) and not ref.search  # a candidate, not yet reported
     return SimpleNamespace(fell=True, seconds=seconds / 2, progress_ratio=0.4, yaw_drift_deg=9.0)
 
 

@@ -37,7 +37,7 @@ from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.ticklearn import learn_tick
 from imitwalk.balance.tickrun import TickJob, tick_walk_metrics
 from imitwalk.balance.tickstore import load_laws
-from imitwalk.errors import RunError
+from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
@@ -62,18 +62,12 @@ class LawWalker:
     engine: str = "mujoco"
 
     def __call__(
-        self,
-        ref_path: str,
-        robot: Robot,
-        scale: float,
-        seed: int,
-        options: SimOptions,
-        seconds: float,
+        self, ref, robot: Robot, scale: float, seed: int, options: SimOptions, seconds: float
     ) -> WalkMetrics:
-        job = TickJob(ref_path, robot, scale, (self.law,), seed, options, seconds,
+        job = TickJob("", robot, scale, (self.law,), seed, options, seconds,
                       engine=self.engine, record=False, feedforward=self.feedforward,
                       wait=self.wait)  # fmt: skip
-        return tick_walk_metrics(job)
+        return tick_walk_metrics(job, ref)
 
 
 def law_walker(run_dir) -> LawWalker:
@@ -153,39 +147,39 @@ def pick(verdicts: list[PassVerdict]) -> str:
 
 
 def learn_clip(
-    motion, robot: Robot, rcfg, cfg: TickLearnConfig, run_dir, resume: bool = False,
-    stamp: dict | None = None, progress=None, search_progress=None, refine_progress=None,
-) -> tuple[LearnSummary, Choice | None]:  # fmt: skip
-    """Retarget ``motion`` (a :class:`~imitwalk.mocap.motion.Motion`) to ``robot`` with
-    ``rcfg`` (a :class:`~imitwalk.retarget.RetargetConfig`), learn, and choose between the
-    two passes (module docstring) into ``run_dir``. ``stamp`` is added to both references'
-    settings (the robot's file, as ``retarget`` records it).
+    make_reference, robot: Robot, cfg: TickLearnConfig, run_dir, resume: bool = False,
+    progress=None,
+) -> tuple[LearnSummary, Choice]:  # fmt: skip
+    """Learn the two passes (module docstring) into ``run_dir`` and keep the better.
+
+    Args:
+        make_reference: ``make_reference(walker)`` retargets the clip to ``robot`` with its
+            reference search walking each candidate under ``walker`` (``None``: open
+            loop; :data:`~imitwalk.retarget.search.Walker`) and returns the
+            :class:`~imitwalk.retarget.reference.Reference`, e.g.
+            ``lambda w: retarget(motion, robot, walker=w).reference``.
+        cfg: the learner's settings; ``cfg.choice`` the choice's (``robots`` ≥ 1).
 
     Returns:
-        the kept run's summary (``metrics.json`` at the top of ``run_dir``) and the choice
-        (``None`` with ``cfg.choice.robots == 0``, or where ``rcfg`` runs no search: pass 1
-        is learned in ``run_dir`` itself).
+        the kept run's summary (``metrics.json`` at the top of ``run_dir``) and the choice.
 
     Raises:
-        RunError: ``run_dir`` holds a run and ``resume`` is off.
+        ConfigError: ``cfg.choice.robots`` is 0 (learn one reference with
+        :func:`~imitwalk.balance.ticklearn.learn_tick`). RunError: ``run_dir`` holds a
+        run and ``resume`` is off.
     """
     from imitwalk.retarget import Reference
 
+    if cfg.choice.robots == 0:
+        raise ConfigError("choice.robots is 0: there is no choice to make; learn one reference")
     say = progress or (lambda _s: None)
     root = RunDir(run_dir)
-    reports = (search_progress, refine_progress)
-    if cfg.choice.robots == 0 or not rcfg.search or rcfg.mapping != "walkable":
-        resumed = resume and root.exists("reference.npz")
-        ref = Reference.load(root.file("reference.npz")) if resumed else None
-        if ref is None:
-            ref = _retarget(motion, robot, rcfg, stamp, say, reports, None)
-        return learn_tick(ref, robot, cfg, run_dir, resume=resumed, progress=say), None
     if not resume and (root.exists("checkpoint.json") or root.file(PASSES[0]).is_dir()):
         raise RunError(f"{root.path} already holds a run; pass --resume or choose another --out")
     if resume and root.exists("choice.json") and root.exists("metrics.json"):
         say(f"learn: {root.path} is finished")
         return root.read_summary(), Choice.from_dict(root.read_json("choice.json"))
-    summaries, walker = {}, None
+    summaries, searched, walker = {}, {}, None
     for i, name in enumerate(PASSES):
         rd = RunDir(root.file(name))
         how = "the open-loop search" if walker is None else "the search under pass 1's law"
@@ -193,30 +187,24 @@ def learn_clip(
         if rd.exists("reference.npz"):
             ref = Reference.load(rd.file("reference.npz"))
         else:
-            ref = _retarget(motion, robot, rcfg, stamp, say, reports, walker)
+            ref = make_reference(walker)
+        searched[name] = float((ref.search or {}).get("sim_seconds", 0.0))
         go_on = rd.exists("checkpoint.json")
         summaries[name] = learn_tick(ref, robot, cfg, rd.path, resume=go_on, progress=say)
         walker = law_walker(rd.path)
-    choice = _judge(root, robot, cfg, summaries, say)
+    choice = _judge(root, robot, cfg, summaries, searched, say)
     _keep(root, choice.kept)
     root.write_json("choice.json", choice.to_dict())
     return summaries[choice.kept], choice
 
 
-def _retarget(motion, robot, rcfg, stamp, say, reports, walker):
-    from imitwalk.retarget import retarget
-
-    say(f"learn: retargeting {motion.source}")
-    res = retarget(motion, robot, rcfg, *reports, walker=walker)
-    say(f"  cycles: {res.template.meta['cycles_report']}")
-    res.reference.settings.update(stamp or {})
-    return res.reference
-
-
-def _judge(root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, say) -> Choice:
+def _judge(
+    root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, searched: dict, say
+) -> Choice:
+    """Each pass's learned controller on the choice's training robots; ``searched``: each
+    pass's reference search's simulated seconds [s]."""
     from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
-    from imitwalk.retarget import Reference
 
     c = cfg.choice
     protocol = replace(load_protocol(cfg.train_protocol), engine=cfg.engine)  # learned there
@@ -230,13 +218,12 @@ def _judge(root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, sa
                            workers=cfg.workers, first=c.first,
                            most_falls=out[0].falls if tie else None)  # fmt: skip
         cv = v.controllers["learned"]
-        search = Reference.load(Path(path) / "reference.npz").search or {}
         walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
         out.append(PassVerdict(
             name, float(s.scale_reached), cv.falls, cv.robots,
             float(cv.progress_ratio_min or 0.0), float(cv.distance_m or 0.0), float(walked),
             s.sim_seconds_used_for_learning, s.wall_seconds_for_learning,
-            float(search.get("sim_seconds", 0.0)),
+            searched[name],
         ))  # fmt: skip
         cut = f" (stopped: more falls than {PASSES[0]})" if cv.robots < c.robots else ""
         say(f"  {name}: {cv.falls} of {cv.robots} fell, slowest progress "

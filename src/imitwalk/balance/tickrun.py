@@ -93,13 +93,14 @@ def _reference(path: str):
     return _REFS[path]
 
 
-def _walk(job: TickJob):
-    """Walk ``job``: its reference, policy, rollout and metrics."""
+def _walk(job: TickJob, ref=None):
+    """Walk ``job`` on ``ref`` (``None``: the reference at ``job.ref_path``): its reference,
+    policy, rollout and metrics."""
     from imitwalk.retarget.feedforward import walk_offsets
     from imitwalk.sim.metrics import walk_metrics
     from imitwalk.sim.mujoco import make_plant, run
 
-    ref = _reference(job.ref_path)
+    ref = ref if ref is not None else _reference(job.ref_path)
     offsets = walk_offsets(ref, job.robot, job.scale, job.seconds, job.feedforward)
     names = job.robot.joint_names
     policy = TickPolicy(
@@ -117,10 +118,11 @@ def _walk(job: TickJob):
     return ref, policy, ro, m
 
 
-def tick_walk_metrics(job: TickJob) -> WalkMetrics:
-    """The :class:`~imitwalk.sim.metrics.WalkMetrics` of walking ``job`` (in the calling
-    process)."""
-    return _walk(job)[3]
+def tick_walk_metrics(job: TickJob, ref) -> WalkMetrics:
+    """The :class:`~imitwalk.sim.metrics.WalkMetrics` of walking ``job`` on ``ref``, a
+    :class:`~imitwalk.retarget.reference.Reference` in memory (``job.ref_path`` unused),
+    in the calling process."""
+    return _walk(job, ref)[3]
 
 
 def run_tick_episode(job: TickJob) -> TickResult:

@@ -154,8 +154,10 @@ def learn(args: argparse.Namespace) -> int:
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
+    from imitwalk.balance.refchoice import PASSES, learn_clip
+
     # a run that chose its reference resumes as it started: the same clip, flags and settings
-    resumed = args.resume and rd.exists("reference.npz") and not rd.file("searched").is_dir()
+    resumed = args.resume and rd.exists("reference.npz") and not rd.file(PASSES[0]).is_dir()
     given = args.reference or resumed
     if flags and given:
         raise ConfigError(
@@ -171,25 +173,25 @@ def learn(args: argparse.Namespace) -> int:
         progress(f"learn: resuming {rd.path}")
     elif args.reference:
         ref = Reference.load(args.reference)
-    elif args.variant != "faithful":  # the per-tick learner chooses between two references
-        from imitwalk.balance.refchoice import learn_clip
-
-        rcfg = _with_command(rcfg, args)
-        _announce_search(rcfg)
-        stamp = {"robot": _where(args.robot), "joint_map": _where(args.joint_map)}
-        summary, choice = learn_clip(_motion(args), robot, rcfg, cfg, args.out, args.resume,
-                                     stamp, progress, search_report, refine_report)  # fmt: skip
-        return _learned(summary, args, rd, choice)
     else:
         motion = _motion(args)
-        progress(f"learn: retargeting {motion.source}")
         rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
-        res = do_retarget(motion, robot, rcfg, search_report, refine_report)
-        progress(f"  cycles: {res.template.meta['cycles_report']}")
-        ref = res.reference
-        ref.settings["robot"] = _where(args.robot)
-        ref.settings["joint_map"] = _where(args.joint_map)
+
+        def make_reference(walker=None):
+            progress(f"learn: retargeting {motion.source}")
+            res = do_retarget(motion, robot, rcfg, search_report, refine_report, walker=walker)
+            progress(f"  cycles: {res.template.meta['cycles_report']}")
+            res.reference.settings["robot"] = _where(args.robot)
+            res.reference.settings["joint_map"] = _where(args.joint_map)
+            return res.reference
+
+        searched = rcfg.search and rcfg.mapping == "walkable"
+        if args.variant != "faithful" and cfg.choice.robots and searched:
+            summary, choice = learn_clip(make_reference, robot, cfg, args.out, args.resume,
+                                         progress)  # fmt: skip
+            return _learned(summary, args, rd, choice)
+        ref = make_reference()
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
     return _learned(summary, args, rd)

@@ -12,10 +12,10 @@ A ``walker`` plays each candidate under a controller instead (a learned balance 
 
 from __future__ import annotations
 
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields, replace
+from functools import partial
 
 import numpy as np
 
@@ -33,11 +33,12 @@ from imitwalk.sim.mujoco import SimOptions, make_plant, playback
 from imitwalk.sim.perturb import perturbed, train_seeds
 from imitwalk.sim.types import ENGINES
 
-__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "Walker", "bounds", "search_params"]
+__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "Walker", "bounds", "open_loop", "search_params"]
 
-#: ``walker(reference_path, robot, scale, seed, options, seconds)`` plays the reference
-#: saved at ``reference_path`` [.npz] under a controller on one robot and returns its
-#: :class:`~imitwalk.sim.metrics.WalkMetrics` (it runs in the search's worker process).
+#: ``walker(reference, robot, scale, seed, options, seconds)`` walks a candidate
+#: :class:`~imitwalk.retarget.reference.Reference` at ``scale`` on one robot for
+#: ``seconds`` [s] and returns its :class:`~imitwalk.sim.metrics.WalkMetrics` (it runs in
+#: the search's worker process). :func:`open_loop` plays it without feedback.
 Walker = Callable[..., WalkMetrics]
 
 #: Search range of each reference parameter; the ranges of the lengths (:data:`LENGTHS`)
@@ -131,6 +132,17 @@ class SearchConfig:
 _IK: dict = {}
 
 
+def open_loop(ref, robot: Robot, scale: float, seed: int, options: SimOptions,
+              seconds: float, engine: str = "mujoco") -> WalkMetrics:  # fmt: skip
+    """The search's default :data:`Walker`: ``ref`` played open loop on ``engine``
+    (``seed`` is drawn into ``options`` already)."""
+    q = ref.trajectory(scale, seconds)
+    ro = playback(make_plant(robot, options, engine), q, q0=q[0])
+    return walk_metrics(
+        ro, ref.expected_distance(scale, ro.seconds), track=ref.track(scale, ro.seconds)
+    )
+
+
 def _trial(job) -> dict:
     template, robot, params, cfg, dt, base, command, walker = job
     key = (robot.name, str(robot.mjcf))
@@ -138,37 +150,27 @@ def _trial(job) -> dict:
     build = build_walkable(template, robot, params, list(cfg.scales), dt, ik=ik, command=command)
     ref = build.reference
     base = ref.sim_options(base)
-    with tempfile.TemporaryDirectory(prefix="imitwalk_search_") as tmp:
-        path = f"{tmp}/candidate.npz"
-        if walker is not None:
-            ref.save(path)
-        runs, score = [], []
-        for s in cfg.scales:
-            q = ref.trajectory(s, cfg.seconds)
-            for seed in train_seeds(cfg.models):
-                if walker is None:
-                    ro = playback(make_plant(robot, perturbed(seed, base), cfg.engine), q, q0=q[0])
-                    m = walk_metrics(
-                        ro, ref.expected_distance(s, ro.seconds), track=ref.track(s, ro.seconds)
-                    )
-                else:
-                    m = walker(path, robot, s, seed, perturbed(seed, base), cfg.seconds)
-                val = (
-                    m.seconds / cfg.seconds
-                    + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
-                    - 0.5 * min(abs(m.yaw_drift_deg) / 45.0, 1.0)
-                )
-                score.append(val)
-                runs.append(
-                    {
-                        "scale": s,
-                        "seed": seed,
-                        "fell": m.fell,
-                        "seconds": m.seconds,
-                        "progress_ratio": m.progress_ratio,
-                        "yaw_drift_deg": m.yaw_drift_deg,
-                    }
-                )
+    walk = walker or partial(open_loop, engine=cfg.engine)
+    runs, score = [], []
+    for s in cfg.scales:
+        for seed in train_seeds(cfg.models):
+            m = walk(ref, robot, s, seed, perturbed(seed, base), cfg.seconds)
+            val = (
+                m.seconds / cfg.seconds
+                + 0.5 * float(np.clip(m.progress_ratio, 0.0, 1.0))
+                - 0.5 * min(abs(m.yaw_drift_deg) / 45.0, 1.0)
+            )
+            score.append(val)
+            runs.append(
+                {
+                    "scale": s,
+                    "seed": seed,
+                    "fell": m.fell,
+                    "seconds": m.seconds,
+                    "progress_ratio": m.progress_ratio,
+                    "yaw_drift_deg": m.yaw_drift_deg,
+                }
+            )
     return {"params": params.to_dict(), "score": float(np.mean(score)), "runs": runs}
 
 
@@ -185,7 +187,8 @@ def search_params(
 ) -> tuple[GaitParams, dict]:
     """Find reference parameters for ``template`` on ``robot`` (walking as ``command``
     says: a turn or sidestep is judged against its own path, a slope on its slope).
-    ``walker`` (:data:`Walker`; ``None``: open loop) walks each candidate.
+    ``walker`` (:data:`Walker`; ``None``: :func:`open_loop` on ``config.engine``) walks
+    each candidate.
 
     Returns:
         the best parameters found and a JSON-able report of every trial.
