@@ -20,6 +20,7 @@ from imitwalk.balance.refchoice import (
     law_walker,
     learn_clip,
     pick,
+    same_gait,
 )
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.cli.main import main
@@ -67,6 +68,40 @@ def test_the_choice_round_trips_and_counts_its_own_cost():
     assert Choice.from_dict(json.loads(json.dumps(c.to_dict()))) == c
     # the kept pass's learning, and the rest: the other learning, both judgements, one search
     assert c.cost() == {"learning_sim_seconds": 1300.0, "choice_sim_seconds": 1300 + 2400 + 640}
+
+
+def test_a_pass_sharing_its_twins_gait_costs_only_its_search():
+    first = _verdict(PASSES[0])
+    twin = replace(first, name=PASSES[1], learn_sim_seconds=0.0, learn_wall_seconds=0.0,
+                   same_as=PASSES[0])  # fmt: skip
+    c = Choice(pick([first, twin]), (first, twin))
+    assert c.kept == PASSES[0] and Choice.from_dict(json.loads(json.dumps(c.to_dict()))) == c
+    assert c.cost() == {"learning_sim_seconds": 1300.0, "choice_sim_seconds": 1200 + 640}
+
+
+def test_same_gait_looks_at_the_gait_not_the_search_report(tick_reference):
+    ref = Reference.load(tick_reference)
+    assert same_gait(ref, replace(ref, search={"method": "another search"}))
+    loops = ref.loops.copy()
+    loops[-1, 0, 0] += 1e-6
+    assert not same_gait(ref, replace(ref, loops=loops))
+    assert not same_gait(ref, replace(ref, params={**ref.params, "sway": -1.0}))
+
+
+def test_a_second_search_that_keeps_the_first_gait_is_not_learned_again(
+    robot, tick_reference, tmp_path
+):
+    ref = Reference.load(tick_reference)
+    cfg = apply_overrides(TickLearnConfig(), QUICK_LEARN)
+    out = tmp_path / "run"
+    summary, choice = learn_clip(lambda walker: ref, robot, cfg, out)
+    assert summary.scale_reached == choice.passes[0].scale
+    assert choice.kept == PASSES[0] and choice.passes[1].same_as == PASSES[0]
+    assert choice.passes[1].learn_sim_seconds == 0.0
+    assert sorted(p.name for p in (out / PASSES[1]).iterdir()) == ["reference.npz"]
+    assert (out / "metrics.json").read_bytes() == (out / PASSES[0] / "metrics.json").read_bytes()
+    again = learn_clip(lambda walker: ref, robot, cfg, out, resume=True)
+    assert again[1] == choice
 
 
 @pytest.mark.parametrize(

@@ -123,3 +123,17 @@ def test_the_settings_round_trip_through_the_run_folders_json():
     assert from_dict(TickLearnConfig, to_dict(cfg)) == cfg
     assert from_dict(TickLearnConfig, to_dict(TickLearnConfig())) == TickLearnConfig()
     assert TrialConfig().box == LqrConfig().box  # the defaults are the measured best
+
+
+def test_overrides_that_check_each_other_apply_in_any_order():
+    from imitwalk.retarget import RetargetConfig
+
+    # elites must not pass the population: each order is checked on the final values
+    keys = ["search_config.population=2", "search_config.elites=1"]
+    for order in (keys, keys[::-1]):
+        cfg = apply_overrides(RetargetConfig(), order).search_config
+        assert (cfg.population, cfg.elites) == (2, 1)
+    with pytest.raises(ConfigError, match=r"elites: 3 is not in 1\.\.2"):
+        apply_overrides(RetargetConfig(), ["search_config.population=2"])
+    # a later value of one key wins
+    assert apply_overrides(TickLearnConfig(), ["robots=3", "robots=5"]).robots == 5

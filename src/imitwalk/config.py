@@ -40,25 +40,33 @@ def _coerce(text: str, current: Any, key: str) -> Any:
         raise ConfigError(f"setting {key}={text!r}: expected {type(current).__name__}") from None
 
 
-def _replace(obj: Any, path: list[str], text: str, full: str) -> Any:
+def _apply(obj: Any, items: list[tuple[list[str], str, str]]) -> Any:
+    """``obj`` with ``items`` (path below ``obj``, value text, the whole key) applied,
+    each field's group rebuilt once with all of its items."""
     if not dataclasses.is_dataclass(obj):
+        path, _text, full = items[0]
         raise ConfigError(f"setting {full!r}: {path[0]!r} is not a group of settings")
     names = [f.name for f in dataclasses.fields(obj)]
-    if path[0] not in names:
-        raise unknown_name(
-            "setting", full, [_prefix(full, path[0]) + n for n in names], ConfigError
-        )
-    current = getattr(obj, path[0])
-    if len(path) == 1:
+    values: dict[str, Any] = {}
+    groups: dict[str, list[tuple[list[str], str, str]]] = {}
+    for path, text, full in items:
+        if path[0] not in names:
+            raise unknown_name(
+                "setting", full, [_prefix(full, path[0]) + n for n in names], ConfigError
+            )
+        current = getattr(obj, path[0])
+        if len(path) > 1:
+            groups.setdefault(path[0], []).append((path[1:], text, full))
+            continue
         if dataclasses.is_dataclass(current):
             raise ConfigError(f"setting {full!r} is a group; set one of its fields")
         if isinstance(current, str) and hasattr(obj, "CHOICES") and path[0] in obj.CHOICES:
             if text not in obj.CHOICES[path[0]]:
                 raise unknown_name(f"value for {full}", text, obj.CHOICES[path[0]], ConfigError)
-        value = _coerce(text, current, full)
-    else:
-        value = _replace(current, path[1:], text, full)
-    return dataclasses.replace(cast(Any, obj), **{path[0]: value})
+        values[path[0]] = _coerce(text, current, full)
+    for name, sub in groups.items():
+        values[name] = _apply(getattr(obj, name), sub)
+    return dataclasses.replace(cast(Any, obj), **values)
 
 
 def _prefix(full: str, last: str) -> str:
@@ -67,13 +75,17 @@ def _prefix(full: str, last: str) -> str:
 
 
 def apply_overrides(cfg: Any, overrides: list[str] | tuple[str, ...] | None) -> Any:
-    """A copy of ``cfg`` with each ``"a.b.c=value"`` override applied."""
+    """A copy of ``cfg`` with each ``"a.b.c=value"`` override applied (a later one of the
+    same key wins). Every settings group is rebuilt once, with all of its overrides, so
+    checks that tie fields together (elites ≤ population) see the final values whatever
+    the order the overrides came in."""
+    items = []
     for item in overrides or ():
         if "=" not in item:
             raise ConfigError(f"setting {item!r} must look like key=value")
         key, text = item.split("=", 1)
-        cfg = _replace(cfg, key.strip().split("."), text.strip(), key.strip())
-    return cfg
+        items.append((key.strip().split("."), text.strip(), key.strip()))
+    return _apply(cfg, items) if items else cfg
 
 
 def schedule_scales(start: float, step: float, stop: float) -> tuple[float, ...]:

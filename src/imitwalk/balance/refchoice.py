@@ -23,6 +23,10 @@ learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
    longer be kept. The kept pass's files are copied to the top of the run folder, where
    ``evaluate`` and ``report`` read them.
 
+Where pass 2's search keeps pass 1's gait (the same parameters, so the same joint
+trajectories), learning and judging it again would repeat pass 1 to the digit: pass 2 is
+recorded as the same (:attr:`PassVerdict.same_as`) and pass 1 is kept.
+
 Every step is kept in the run folder, so ``--resume`` goes on from the last one done.
 """
 
@@ -44,7 +48,10 @@ from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
 
-__all__ = ["PASSES", "Choice", "LawWalker", "PassVerdict", "law_walker", "learn_clip", "pick"]
+__all__ = [
+    "PASSES", "Choice", "LawWalker", "PassVerdict", "law_walker", "learn_clip", "pick",
+    "same_gait",
+]  # fmt: skip
 
 #: The two passes, in the order they run (a tie keeps the first).
 PASSES = ("searched", "closed")
@@ -92,7 +99,9 @@ class PassVerdict:
         walked at; falls, robots: counts; progress_min: the slowest robot's progress ratio;
         distance_m: mean forward distance [m]; walked_s: simulated time walked [s];
         learn_sim_seconds, learn_wall_seconds: its learning's cost [s]; search_sim_seconds:
-        its reference search's simulated time [s].
+        its reference search's simulated time [s]; same_as: the earlier pass whose gait
+        its search kept, whose learning and verdict it shares (none run again; empty: its
+        own).
     """
 
     name: str
@@ -105,6 +114,7 @@ class PassVerdict:
     learn_sim_seconds: float
     learn_wall_seconds: float
     search_sim_seconds: float
+    same_as: str = ""
 
     def rank(self) -> tuple:
         """The order passes are kept in (least first): the larger scale, the fewer falls;
@@ -132,11 +142,12 @@ class Choice:
         """Simulated seconds [s] by what spent them: the kept pass's learning, and the
         choice (pass 2's search, the other pass's learning, every pass's judgement)."""
         kept = next(p for p in self.passes if p.name == self.kept)
-        other = sum(p.learn_sim_seconds for p in self.passes) - kept.learn_sim_seconds
+        own = [p for p in self.passes if not p.same_as]  # a shared gait was not run again
+        other = sum(p.learn_sim_seconds for p in own) - kept.learn_sim_seconds
         return {
             "learning_sim_seconds": kept.learn_sim_seconds,
             "choice_sim_seconds": other
-            + sum(p.walked_s for p in self.passes)
+            + sum(p.walked_s for p in own)
             + sum(p.search_sim_seconds for p in self.passes[1:]),
         }
 
@@ -179,7 +190,11 @@ def learn_clip(
     if resume and root.exists("choice.json") and root.exists("metrics.json"):
         say(f"learn: {root.path} is finished")
         return root.read_summary(), Choice.from_dict(root.read_json("choice.json"))
-    summaries, searched, walker = {}, {}, None
+    summaries: dict[str, LearnSummary] = {}
+    refs: dict[str, Reference] = {}
+    searched: dict[str, float] = {}
+    same: dict[str, str] = {}
+    walker = None
     for i, name in enumerate(PASSES):
         rd = RunDir(root.file(name))
         how = "the open-loop search" if walker is None else "the search under pass 1's law"
@@ -189,20 +204,44 @@ def learn_clip(
         else:
             ref = make_reference(walker)
         searched[name] = float((ref.search or {}).get("sim_seconds", 0.0))
+        twin = next((n for n, r in refs.items() if same_gait(ref, r)), "")
+        refs[name] = ref
+        if twin:  # learning it again would repeat the twin's learning to the digit
+            say(f"learn: pass {i + 1}'s search kept pass {twin}'s gait; not learned again")
+            rd.path.mkdir(parents=True, exist_ok=True)
+            ref.save(rd.file("reference.npz"))
+            same[name], summaries[name] = twin, summaries[twin]
+            continue
         go_on = rd.exists("checkpoint.json")
         summaries[name] = learn_tick(ref, robot, cfg, rd.path, resume=go_on, progress=say)
         walker = law_walker(rd.path)
-    choice = _judge(root, robot, cfg, summaries, searched, say)
+    choice = _judge(root, robot, cfg, summaries, searched, same, say)
     _keep(root, choice.kept)
     root.write_json("choice.json", choice.to_dict())
     return summaries[choice.kept], choice
 
 
+def same_gait(a, b) -> bool:
+    """True if two references of one clip and robot play the same gait: the same
+    parameters and the same joint trajectories at every scale (their search reports may
+    differ)."""
+    import numpy as np
+
+    return (
+        a.params == b.params
+        and a.scale_params == b.scale_params
+        and all(np.array_equal(getattr(a, k), getattr(b, k))
+                for k in ("scales", "loops", "starts", "start_travel"))
+    )  # fmt: skip
+
+
 def _judge(
-    root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, searched: dict, say
-) -> Choice:
+    root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, searched: dict,
+    same: dict, say,
+) -> Choice:  # fmt: skip
     """Each pass's learned controller on the choice's training robots; ``searched``: each
-    pass's reference search's simulated seconds [s]."""
+    pass's reference search's simulated seconds [s]; ``same``: the passes that share an
+    earlier pass's gait, and whose."""
     from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
 
@@ -211,6 +250,12 @@ def _judge(
     say(f"learn: judging both passes on {c.robots} training robots x {c.seconds:g} s")
     out: list[PassVerdict] = []
     for name in PASSES:
+        if name in same:  # its twin's verdict, walked once
+            twin = next(v for v in out if v.name == same[name])
+            out.append(replace(twin, name=name, learn_sim_seconds=0.0, learn_wall_seconds=0.0,
+                               search_sim_seconds=searched[name], same_as=twin.name))  # fmt: skip
+            say(f"  {name}: {twin.name}'s gait, {twin.name}'s verdict")
+            continue
         path, s = root.file(name), summaries[name]
         # at pass 1's scale, a pass that has fallen more often can no longer be kept
         tie = out and s.scale_reached == out[0].scale
