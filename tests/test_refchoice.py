@@ -5,6 +5,7 @@ the run folder the whole choice writes and resumes."""
 from __future__ import annotations
 
 import json
+import shutil
 from dataclasses import replace
 from types import SimpleNamespace
 
@@ -183,16 +184,38 @@ def test_an_interrupted_choice_resumes_to_the_same_choice(tmp_path, capsys):
     argv = ["learn", "--out", str(out), "--json", *sets([*QUICK_SEARCH, *QUICK_LEARN])]
     assert main(argv) == 0
     whole = json.loads(capsys.readouterr().out)["reference_choice"]
-    # stopped in pass 2's learning, before the choice: its checkpoint kept, the rest gone
+    # stopped in pass 2's search, before the choice: pass 1 kept, the rest gone
     for name in ("choice.json", "metrics.json", "checkpoint.json", "reference.npz"):
         (out / name).unlink()
-    (out / "closed" / "metrics.json").unlink()
+    shutil.rmtree(out / PASSES[1])
     assert main([*argv, "--resume"]) == 0
     again = json.loads(capsys.readouterr().out)["reference_choice"]
     assert _no_wall(again) == _no_wall(whole)
     assert (out / "reference.npz").read_bytes() == (
         out / again["kept"] / "reference.npz"
     ).read_bytes()
+
+
+def test_a_choice_stopped_in_pass_2s_learning_resumes_to_the_same_choice(
+    robot, tick_reference, tmp_path
+):
+    first = Reference.load(tick_reference)
+    second = replace(first, loops=first.loops + 1e-3)  # another gait, learned again
+
+    def make(walker):
+        return first if walker is None else second
+
+    cfg = apply_overrides(TickLearnConfig(), QUICK_LEARN)
+    out = tmp_path / "run"
+    _summary, whole = learn_clip(make, robot, cfg, out)
+    assert not any(p.same_as for p in whole.passes)
+    assert (out / PASSES[1] / "checkpoint.json").is_file()
+    for name in ("choice.json", "metrics.json", "checkpoint.json", "reference.npz"):
+        (out / name).unlink()
+    (out / PASSES[1] / "metrics.json").unlink()
+    _summary, again = learn_clip(make, robot, cfg, out, resume=True)
+    assert _no_wall(again.to_dict()) == _no_wall(whole.to_dict())
+    assert (out / "reference.npz").read_bytes() == (out / again.kept / "reference.npz").read_bytes()
 
 
 def test_a_reference_not_searched_is_learned_once(tmp_path, capsys):
