@@ -271,8 +271,9 @@ def _judge(
             searched[name],
         ))  # fmt: skip
         cut = f" (stopped: more falls than {PASSES[0]})" if cv.robots < c.robots else ""
-        say(f"  {name}: {cv.falls} of {cv.robots} fell, slowest progress "
-            f"{cv.progress_ratio_min or 0.0:.2f}{cut}")  # fmt: skip
+        how = (f"walked {walked / cv.robots:.1f} s on average" if cv.falls == cv.robots
+               else f"slowest progress {cv.progress_ratio_min or 0.0:.2f}")  # fmt: skip
+        say(f"  {name}: {cv.falls} of {cv.robots} fell, {how}{cut}")
     kept = pick(out)
     say(f"learn: keeping pass {kept}")
     return Choice(kept, tuple(out))
