@@ -47,8 +47,10 @@ def _yaw(quat) -> float:
 class CaptureStep:
     """``policy(k, obs)``: the run's policy, its swing foot moved to the capture point."""
 
-    def __init__(self, policy, plant, robot, plan, gain, release, clip, inward, nominal=None):
+    def __init__(self, policy, plant, robot, plan, gain, release, clip, inward, nominal=None,
+                 predict=False):  # fmt: skip
         self.policy, self.plant, self.robot = policy, plant, robot
+        self.predict = predict
         self.gain, self.clip, self.inward = gain, clip, inward
         self.decay = 0.0 if not np.isfinite(release) else 1.0 / max(release / 0.01, 1.0)
         self.m = robot.compile()
@@ -103,6 +105,7 @@ class CaptureStep:
 
     def __call__(self, k: int, obs) -> np.ndarray:
         q = self.policy(k, obs)
+        k = self.policy.clock.clock if self.policy.clock is not None else k  # reference tick
         row = self._row(min(k, len(self.policy.q_cmd) - 1))
         up = {f: bool(self.up[f][row]) for f in LEGS}
         for f in LEGS:
@@ -110,19 +113,21 @@ class CaptureStep:
             if up[f] and not up[stance]:
                 xi = self._xi_rel(stance)
                 if self.nominal is None:
-                    self.record[k] = xi
+                    if k < len(self.record):
+                        self.record[k] = xi
                     continue
                 nom = self.nominal[k] if k < len(self.nominal) else np.nan
                 if np.any(np.isnan(nom)):
                     continue
-                target = self.gain * (xi - nom)
+                left = 1
+                while row + left < len(self.up[f]) and self.up[f][row + left]:
+                    left += 1
+                grow = np.exp(self.w0 * left * 0.01) if self.predict else 1.0
+                target = self.gain * grow * (xi - nom)  # at the landing, if predicted
                 side = 1.0 if f == "l" else -1.0  # +y is outward for the left foot
                 lo, hi = (-self.inward, self.clip) if side > 0 else (-self.clip, self.inward)
                 target = np.array([np.clip(target[0], -self.clip, self.clip),
                                    np.clip(target[1], lo, hi)])  # fmt: skip
-                left = 1
-                while row + left < len(self.up[f]) and self.up[f][row + left]:
-                    left += 1
                 self.off[f] = self.off[f] + (target - self.off[f]) / left
             elif not up[f]:
                 self.off[f] = self.off[f] * (1.0 - self.decay)
@@ -132,15 +137,17 @@ class CaptureStep:
 
 
 def walk(job) -> dict:
-    path, seed, options, gain, release, clip, inward, nominal = job
+    path, seed, options, gain, release, clip, inward, nominal, predict, wait = job
     r = load_run(path)
     robot = load_robot(r.metrics.robot if hasattr(r.metrics, "robot") else "hoap2")
     ref, s = r.ref, r.settings_of("learned")
-    assert s["wait"] == 0.0, "the bench reads the plan at the control tick: no wait"
+    wait = s["wait"] if wait is None else wait
     offsets = walk_offsets(ref, robot, r.scale, SECONDS, s["feedforward"])
-    pol = TickPolicy(ref, r.scale, r.laws["learned"], robot.joint_names, SECONDS, offsets=offsets)
+    pol = TickPolicy(ref, r.scale, r.laws["learned"], robot.joint_names, SECONDS,
+                     offsets=offsets, wait=wait)  # fmt: skip
     plant = make_plant(robot, ref.sim_options(options), "mujoco")
-    cs = CaptureStep(pol, plant, robot, ref.plan_at(r.scale), gain, release, clip, inward, nominal)
+    cs = CaptureStep(pol, plant, robot, ref.plan_at(r.scale), gain, release, clip, inward,
+                     nominal, predict)  # fmt: skip
     ro = run(plant, cs, len(pol.q_ref))
     m = walk_metrics(ro, ref.expected_distance(r.scale, ro.seconds), pol.q_ref,
                      ref.track(r.scale, ro.seconds))  # fmt: skip
@@ -158,23 +165,28 @@ def main() -> None:
     ap.add_argument("--clip", type=float, default=0.04)
     ap.add_argument("--inward", type=float, default=0.01)
     ap.add_argument("--variants", default="pushes,hard,eval")
+    ap.add_argument("--predict", action="store_true", help="the deviation grown to the landing")
+    ap.add_argument("--waits", default="", help="the clock's waits tried (default: the run's)")
     a = ap.parse_args()
     r = load_run(a.run_dir)
     robot = load_robot("hoap2")
     base = r.ref.sim_options()
-    nominal = walk((a.run_dir, 0, base, 0.0, np.inf, a.clip, a.inward, None))["record"]
+    waits = [float(w) for w in a.waits.split(",")] if a.waits else [None]
+    nominal = {w: walk((a.run_dir, 0, base, 0.0, np.inf, a.clip, a.inward, None, False, w))["record"]
+               for w in waits}  # fmt: skip
     hard = load_protocol("hard")
     protos = {"pushes": hard.only(("pushes",)), "hard": hard, "eval": load_protocol("eval")}
     out = []
     for v in a.variants.split(","):
         p = protos[v]
         draws = [p.draw(a.first + i, robot, base, SECONDS) for i in range(a.robots)]
-        for g in map(float, a.gains.split(",")):
-            for rel in (map(float, a.release.split(",")) if g else [np.inf]):
-                jobs = [(a.run_dir, d.seed, d.options, g, rel, a.clip, a.inward, nominal)
-                        for d in draws]  # fmt: skip
+        for w, g, rel in [(w, g, rel) for w in waits for g in map(float, a.gains.split(","))
+                          for rel in (map(float, a.release.split(",")) if g else [np.inf])]:
+            if True:
+                jobs = [(a.run_dir, d.seed, d.options, g, rel, a.clip, a.inward, nominal[w],
+                         a.predict, w) for d in draws]  # fmt: skip
                 res = run_parallel(walk, jobs)
-                row = {"variant": v, "gain": g, "release": rel,
+                row = {"variant": v, "wait": w, "gain": g, "release": rel,
                        "falls": sum(x["fell"] for x in res), "robots": len(res),
                        "d": float(np.mean([x["d"] for x in res])),
                        "fall_t": sorted(round(x["t"], 1) for x in res if x["fell"])}  # fmt: skip
