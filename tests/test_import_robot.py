@@ -237,3 +237,13 @@ def test_importing_hoap2_gives_back_its_own_joint_map(tmp_path, capsys):
     drafted, own = json.loads(out.read_text()), json.loads(BUILTIN["hoap2"].read_text())
     assert drafted.pop("mjcf").endswith("hoap2.xml") and own.pop("mjcf") == "hoap2.xml"
     assert drafted == own
+
+
+def test_bullet_says_what_the_robots_rotors_are(drafted, capsys):
+    from imitwalk.robots.urdf import rotor_note, rotor_ratio
+
+    # OP3's rotors carry most of what its leg joints do; Bullet has none
+    assert rotor_ratio(load_robot(_import(drafted, "op3", capsys)[0])) > 30.0
+    assert rotor_ratio(load_robot(_import(drafted, "g1", capsys)[0])) < 1.0
+    note = rotor_note(load_robot("hoap2"))
+    assert "\n" not in note and "hoap2's leg rotors are 3.5 x" in note

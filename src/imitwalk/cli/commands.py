@@ -212,6 +212,7 @@ def evaluate(args: argparse.Namespace) -> int:
     from imitwalk.errors import ConfigError
     from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.robots.urdf import rotor_note
     from imitwalk.runs import RunDir
 
     rd = RunDir(args.run_dir)
@@ -231,6 +232,8 @@ def evaluate(args: argparse.Namespace) -> int:
         f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
         f"{args.seeds} robots x {args.seconds:g} s"
     )
+    if protocol.engine == "bullet":
+        progress(f"evaluate: note: {rotor_note(robot)}")
     out = judge_protocol(
         rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
         scale=args.scale, workers=args.workers, explain=args.explain_falls,
