@@ -27,7 +27,7 @@ import pybullet as pb
 from imitwalk.robots import Robot
 from imitwalk.robots.servos import actuator_kind, torque_limit
 from imitwalk.robots.urdf import urdf_file
-from imitwalk.sim.servo import RotorPD, StablePD
+from imitwalk.sim.servo import StablePD
 from imitwalk.sim.types import (
     Observation,
     ServoQueue,
@@ -38,10 +38,6 @@ from imitwalk.sim.types import (
 )
 
 __all__ = ["BulletPlant"]
-
-import os
-
-ROTORS = bool(os.environ.get("IMITWALK_ROTORS"))  # prototype switch
 
 
 def _rot(quat_xyzw) -> np.ndarray:
@@ -111,8 +107,7 @@ class BulletPlant:
         self.limit = robot.torque_limit
         limit = np.r_[self.limit, [torque_limit(m, act_for[j], j) for j in held]]
         kp = np.r_[robot.kp * kps, m.actuator_gainprm[[act_for[j] for j in held], 0]]
-        arm = m.dof_armature[m.jnt_dofadr[every]]
-        self.servo = RotorPD(kp, kd, limit, self.dt, arm) if ROTORS else StablePD(kp, kd, limit, self.dt)
+        self.servo = StablePD(kp, kd, limit, self.dt)
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
@@ -215,14 +210,9 @@ class BulletPlant:
         cid = {"physicsClientId": c}
         self._queue.issue(self._steps, self._cmd)
         states = pb.getJointStates(self.body, self._all_dofs, physicsClientId=c)
-        full = np.array(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
+        mass = np.diag(pb.calculateMassMatrix(self.body, [s[0] for s in states], physicsClientId=c))
         dofs = self._dof + self._held  # the held hinges' servos keep the standing posture
-        idx = 6 + np.array(dofs)
-        if ROTORS:  # joint-space inertia, the floating base eliminated
-            qb = full[np.ix_(idx, range(6))]
-            mjj = full[np.ix_(idx, idx)] - qb @ np.linalg.solve(full[:6, :6], qb.T)
-        else:
-            mjj = np.diag(full)[idx]  # each joint's own inertia [kg m²]
+        mjj = mass[6 + np.array(dofs)]  # each joint's own inertia [kg m²]
         for _ in range(self.substeps):
             states = pb.getJointStates(self.body, dofs, physicsClientId=c)
             q, qd = np.array([s[:2] for s in states]).T  # angles, velocities
@@ -289,7 +279,7 @@ class BulletPlant:
 
     def torques(self) -> np.ndarray:
         """``(n,)`` each servo's output torque over the last physics step [Nm]."""
-        return getattr(self.servo, "motor", self.servo.tau)[: len(self._dof)] * self._sign
+        return self.servo.tau[: len(self._dof)] * self._sign
 
     def torque_limits(self) -> np.ndarray:
         """``(n,)`` each servo's torque limit [Nm]."""

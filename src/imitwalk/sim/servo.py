@@ -58,31 +58,3 @@ class StablePD:
         tau = (self.kp * (target - q) - self.damp * qd - ratio * other) / (1.0 + ratio)
         self.tau, self._qd = np.clip(tau, -self.limit, self.limit), np.asarray(qd, float)
         return self.tau
-
-
-class RotorPD(StablePD):
-    """:class:`StablePD` with each servo's rotor inertia (MuJoCo's ``armature``) carried
-    by the servo, the joints coupled through the joint-space inertia ``M`` (the floating
-    base eliminated): ``(M + A) q̈ = τ + τ_o``, the links driven by ``τ − A q̈``, and the
-    stable PD's implicit step solved with ``M + A`` in place of each ``M_jj``."""
-
-    def __init__(self, kp, kd, limit, dt: float, armature: np.ndarray):
-        super().__init__(kp, kd, limit, dt)
-        self.armature = np.asarray(armature, float)
-
-    def reset(self) -> None:
-        super().reset()
-        self.motor = np.zeros(len(self.kp))
-
-    def torque(self, target, q, qd, mjj) -> np.ndarray:
-        """As :meth:`StablePD.torque`, ``mjj`` the ``(n, n)`` joint-space inertia [kg m²]."""
-        dt, m = self.dt, np.asarray(mjj, float)
-        now = m @ ((qd - self._qd) / dt) - self.tau  # the other torques over the last step
-        self._other = other = self._other + SMOOTH * (now - self._other)
-        inv = np.linalg.inv(m + np.diag(self.armature))
-        lhs = np.eye(len(self.kp)) + dt * self.damp[:, None] * inv
-        rhs = self.kp * (target - q) - self.damp * qd - dt * self.damp * (inv @ other)
-        self.motor = np.clip(np.linalg.solve(lhs, rhs), -self.limit, self.limit)
-        self.tau = self.motor - self.armature * (inv @ (self.motor + other))
-        self._qd = np.asarray(qd, float)
-        return self.tau
