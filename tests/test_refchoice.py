@@ -160,6 +160,7 @@ def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, caps
     for name in ("metrics.json", "checkpoint.json", "reference.npz", "learned.npz"):
         if (out / kept / name).exists():
             assert (out / name).read_bytes() == (out / kept / name).read_bytes(), name
+            assert (out / name).samefile(out / kept / name), name  # linked, not stored twice
     assert "learned law" in Reference.load(out / "closed" / "reference.npz").search["method"]
     config = json.loads((out / "config.json").read_text())
     assert config["learn"]["choice"] == {"robots": 2, "seconds": 5.0, "first": 1001}

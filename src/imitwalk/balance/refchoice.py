@@ -20,7 +20,7 @@ learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
    (where every robot fell, walked longer), then kept the larger slowest progress ratio
    is kept; a tie keeps pass 1. Pass 2 stops
    walking once it has fallen more often than pass 1 at the same scale, where it can no
-   longer be kept. The kept pass's files are copied to the top of the run folder, where
+   longer be kept. The kept pass's files are linked to the top of the run folder, where
    ``evaluate`` and ``report`` read them.
 
 Where pass 2's search keeps pass 1's gait (the same parameters, so the same joint
@@ -32,6 +32,7 @@ Every step is kept in the run folder, so ``--resume`` goes on from the last one 
 
 from __future__ import annotations
 
+import os
 import shutil
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -280,9 +281,19 @@ def _judge(
 
 
 def _keep(root: RunDir, name: str) -> None:
-    """Copy the kept pass's files to the top of ``root``, ``metrics.json`` last."""
+    """Link the kept pass's files to the top of ``root`` (copied where the file system has
+    no hard links), ``metrics.json`` last. Every run file is written whole and renamed into
+    place, so a link is never changed through the other name."""
     src = Path(root.file(name))
     files = sorted((p for p in src.iterdir() if p.is_file() and not p.name.startswith(".")),
                    key=lambda p: p.name == "metrics.json")  # fmt: skip
     for p in files:
-        atomic_write(root.file(p.name), lambda tmp, p=p: shutil.copyfile(p, tmp))
+        atomic_write(root.file(p.name), lambda tmp, p=p: _link(p, tmp))
+
+
+def _link(src: Path, dst: Path) -> None:
+    dst.unlink()
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copyfile(src, dst)
