@@ -294,3 +294,10 @@ def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
             assert r.commanded_turn_deg > 20.0  # ~4.8° per cycle for 10 s
             if not r.fell:  # it follows the turn: what is left is a drift, not the turn
                 assert abs(r.yaw_drift_deg) < r.commanded_turn_deg / 2
+
+
+@pytest.mark.parametrize("mapping", ["walkable", "paper"])
+@pytest.mark.parametrize("search", [True, False])
+def test_a_config_searches_only_the_walkable_mapping(mapping, search):
+    cfg = RetargetConfig(mapping=mapping, search=search)
+    assert cfg.searches == (search and mapping == "walkable")

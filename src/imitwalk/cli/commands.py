@@ -73,7 +73,7 @@ def _where(robot: str | None) -> str | None:
 def _announce_search(cfg) -> None:
     """What a RetargetConfig's search does after its generations (progress lines)."""
     sc = cfg.search_config
-    if cfg.search and sc.refine_rounds:
+    if cfg.searches and sc.refine_rounds:
         at = "/".join(f"{x:g}" for x in sc.refine_scales)
         r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
         each = ", each scale on its own" if sc.refine_per_scale else ""
@@ -129,6 +129,7 @@ def _with_command(cfg, args: argparse.Namespace):
 
 
 def learn(args: argparse.Namespace) -> int:
+    from imitwalk.balance.refchoice import PASSES, learn_clip
     from imitwalk.config import apply_overrides
     from imitwalk.errors import ConfigError
     from imitwalk.retarget import Reference, RetargetConfig
@@ -154,8 +155,6 @@ def learn(args: argparse.Namespace) -> int:
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
-    from imitwalk.balance.refchoice import PASSES, learn_clip
-
     # a run that chose its reference resumes as it started: the same clip, flags and settings
     resumed = args.resume and rd.exists("reference.npz") and not rd.file(PASSES[0]).is_dir()
     given = args.reference or resumed
@@ -186,8 +185,7 @@ def learn(args: argparse.Namespace) -> int:
             res.reference.settings["joint_map"] = _where(args.joint_map)
             return res.reference
 
-        searched = rcfg.search and rcfg.mapping == "walkable"
-        if args.variant != "faithful" and cfg.choice.robots and searched:
+        if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
             summary, choice = learn_clip(make_reference, robot, cfg, args.out, args.resume,
                                          progress)  # fmt: skip
             return _learned(summary, args, rd, choice)

@@ -67,6 +67,12 @@ class RetargetConfig:
     cadence: float = 1.0
     command: GaitCommand = field(default_factory=GaitCommand)
 
+    @property
+    def searches(self) -> bool:
+        """True if :func:`retarget` searches the reference parameters: ``search`` on and
+        the walkable mapping (the paper's mapping has no parameters to search)."""
+        return self.search and self.mapping == "walkable"
+
 
 @dataclass
 class RetargetResult:
@@ -145,7 +151,7 @@ def retarget(
     if cfg.mapping not in MAPPINGS:
         raise unknown_name("mapping", cfg.mapping, MAPPINGS, ConfigError)
     sc = cfg.search_config
-    if cfg.search and sc.refine_rounds and sc.refine_per_scale:
+    if cfg.searches and sc.refine_rounds and sc.refine_per_scale:
         if off := off_grid(cfg.scales, sc.refine_scales):
             grid = ", ".join(f"{x:g}" for x in cfg.scales)
             raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
@@ -163,7 +169,7 @@ def retarget(
         check_side(cfg.command, leg)  # before any search: the sidestep scales with the leg
         # a lift left unset is a tenth of this robot's leg
         params, report, own = cfg.params.for_leg(leg), {}, None
-        if cfg.search:
+        if cfg.searches:
             params, report = search_params(
                 template,
                 robot,
