@@ -108,7 +108,6 @@ def _install_walk() -> None:
     servo_offsets = ff.servo_offsets
 
     def offsets(robot, q_ref, stance, share, dt):
-        from imitwalk.retarget.ik import leg_geometry
 
         if "pitch" not in state:
             return servo_offsets(robot, q_ref, stance, share, dt)
