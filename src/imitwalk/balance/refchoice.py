@@ -17,7 +17,7 @@ learned, and training robots decide (docs/RESULTS.md, "The reference choice"):
 3. ``choice.json``: each pass's learned controller walks ``choice.robots`` training robots
    (:class:`~imitwalk.balance.tickconfig.ChoiceConfig`; the learner's ``train_protocol``,
    on the engine it learned on). The pass that reached the larger scale, then fell less
-   (where every robot fell, walked longer), then kept the larger slowest progress ratio
+   (where every robot fell, walked longer), then had the larger slowest progress ratio,
    is kept; a tie keeps pass 1. Pass 2 stops
    walking once it has fallen more often than pass 1 at the same scale, where it can no
    longer be kept. The kept pass's files are linked to the top of the run folder, where
@@ -36,6 +36,8 @@ import os
 import shutil
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+
+import numpy as np
 
 from imitwalk.balance.feedback import FeedbackLaw
 from imitwalk.balance.tickconfig import TickLearnConfig
@@ -226,8 +228,6 @@ def same_gait(a, b) -> bool:
     """True if two references of one clip and robot play the same gait: the same
     parameters and the same joint trajectories at every scale (their search reports may
     differ)."""
-    import numpy as np
-
     return (
         a.params == b.params
         and a.scale_params == b.scale_params

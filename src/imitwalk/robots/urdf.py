@@ -220,7 +220,7 @@ def rotor_ratio(robot: Robot) -> float:
     mujoco.mj_forward(m, d)
     full = np.zeros((m.nv, m.nv))
     mujoco.mj_fullM(m, d, full)
-    legs = [robot.mj_joints[robot.joint_names.index(r)] for r in LEG_ROLES]
+    legs = [robot.mj_joints[robot.index(r)] for r in LEG_ROLES]
     dof = m.jnt_dofadr[[m.joint(j).id for j in legs]]
     rotor = m.dof_armature[dof]
     return float(np.median(rotor / np.maximum(np.diag(full)[dof] - rotor, 1e-12)))
@@ -228,6 +228,8 @@ def rotor_ratio(robot: Robot) -> float:
 
 def rotor_note(robot: Robot) -> str:
     """One line on what Bullet's copy of ``robot`` lacks: its rotors (:func:`rotor_ratio`)."""
-    return (f"Bullet has no rotor inertia (MuJoCo's armature); {robot.name}'s leg rotors are "
-            f"{rotor_ratio(robot):.1f} x their joints' own inertia (median), which Bullet's "
-            f"robot lacks")  # fmt: skip
+    ratio = rotor_ratio(robot)
+    return (
+        f"Bullet's robot has no rotor inertia (MuJoCo's armature): {robot.name}'s leg "
+        f"rotors are {ratio:.1f} x their joints' own inertia (median)"
+    )
