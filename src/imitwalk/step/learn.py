@@ -1,0 +1,219 @@
+"""Learning the stepping gait's gains: CMA-ES on training robots, checkpointed.
+
+All of the stepping controller's gains (:class:`~imitwalk.step.gains.StepGains`) that
+:attr:`StepLearnConfig.names` lists are chosen together by the covariance matrix
+adaptation evolution strategy (Hansen, 2016; the ``cmaes`` package) in the unit box of
+their ranges, starting from :data:`~imitwalk.step.gains.MODEL_GAINS`. Each generation
+walks every candidate on the same few training robots, drawn from a protocol (``hard``
+by default: friction, mass, servos, a shifted torso, noisy sensors, late servos,
+slopes and kicks) at seeds that no judge uses (from :data:`TRAIN_FIRST`); each
+generation draws new ones. A candidate's cost is the mean of its walks'
+(:func:`~imitwalk.step.episode.score_walk`: falls first, then progress and heading).
+
+At the end the best candidate of each generation, and the start, walk the same
+:attr:`StepLearnConfig.final_robots` fresh robots, and the one with the least cost
+there is kept: a generation's winner on five robots is partly luck.
+
+The run folder holds ``cma.pkl`` (the optimiser, its random state included) and
+``log.jsonl`` after every generation, so ``resume`` ends exactly where an
+uninterrupted run would.
+"""
+
+from __future__ import annotations
+
+import pickle
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from imitwalk.errors import ConfigError, RunError, unknown_name
+from imitwalk.fileio import atomic_write
+from imitwalk.parallel import run_parallel
+from imitwalk.robots import Robot
+from imitwalk.runs import RunDir
+from imitwalk.step.episode import StepJob, StepScore, mean_cost, run_step_job
+from imitwalk.step.gains import BOUNDS, MODEL_GAINS, StepGains
+from imitwalk.step.style import GaitStyle
+
+__all__ = ["SEARCHED", "TRAIN_FIRST", "StepLearnConfig", "StepLearnResult", "learn_step"]
+
+#: Training robots are drawn from this seed on (judges use 0 … 39, validation 300 000 on).
+TRAIN_FIRST = 1001
+#: The final choice's robots, after the generations' ones.
+FINAL_FIRST = 200_001
+#: The gains searched by default: all but the heading's (a slow trim that a few short
+#: walks cannot rank) and the torso's.
+SEARCHED = tuple(n for n in BOUNDS if n not in ("heading", "torso"))
+
+
+@dataclass(frozen=True)
+class StepLearnConfig:
+    """How the gains are learned.
+
+    Attributes:
+        robots: training robots per generation; seconds: each walk [s];
+        generations: CMA-ES generations; population: candidates per generation;
+        sigma: CMA-ES's initial step, in the unit box of each gain's range;
+        protocol: the protocol the training robots are drawn from; names: the gains
+        searched; final_robots: robots of the final choice (0: keep the best
+        generation winner as it is); seed: CMA-ES's seed; engine: the physics engine.
+    """
+
+    robots: int = 5
+    seconds: float = 8.0
+    generations: int = 5
+    population: int = 8
+    sigma: float = 0.15
+    protocol: str = "hard"
+    names: tuple[str, ...] = SEARCHED
+    final_robots: int = 8
+    seed: int = 0
+    engine: str = "mujoco"
+
+    def __post_init__(self) -> None:
+        for n in self.names:
+            if n not in BOUNDS:
+                raise unknown_name("gain", n, tuple(BOUNDS), ConfigError)
+        checks = {
+            "robots": self.robots >= 1,
+            "seconds": self.seconds > 0,
+            "generations": self.generations >= 1,
+            "population": self.population >= 2,
+            "sigma": 0 < self.sigma <= 1,
+            "final_robots": self.final_robots >= 0,
+        }
+        for k, ok in checks.items():
+            if not ok:
+                raise ConfigError(f"learn setting {k}={getattr(self, k)!r} is out of range")
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        d = asdict(self)
+        d["names"] = list(self.names)
+        return d
+
+    def budget(self) -> float:
+        """Simulated seconds the run walks at most [s]."""
+        gen = self.generations * self.population * self.robots * self.seconds
+        final = (self.generations + 1) * self.final_robots * self.seconds if self.final_robots else 0
+        return gen + final
+
+
+@dataclass(frozen=True)
+class StepLearnResult:
+    """What learning gave: the kept ``gains``; ``history``, per generation its best and
+    mean cost and the best candidate's gains; ``final``, each finalist's cost on the
+    final robots (``"start"`` and ``"generation N"``); the ``sim_seconds`` walked and the
+    ``wall_seconds`` taken."""
+
+    gains: StepGains
+    history: list = field(default_factory=list)
+    final: dict = field(default_factory=dict)
+    sim_seconds: float = 0.0
+    wall_seconds: float = 0.0
+
+
+def _robots(protocol: str, robot: Robot, first: int, count: int, seconds: float):
+    from imitwalk.judge.protocol import load_protocol
+
+    proto = load_protocol(protocol)
+    return [proto.draw(first + i, robot, seconds=seconds) for i in range(count)]
+
+
+def _walk_all(
+    candidates: list[StepGains], draws, robot: Robot, style: GaitStyle, cfg: StepLearnConfig
+) -> list[list[StepScore]]:
+    jobs = [
+        StepJob(robot, style, g, d.seed, d.options, cfg.seconds, cfg.engine)
+        for g in candidates
+        for d in draws
+    ]
+    res = run_parallel(run_step_job, jobs)
+    n = len(draws)
+    return [res[i * n : (i + 1) * n] for i in range(len(candidates))]
+
+
+def learn_step(
+    robot: Robot,
+    style: GaitStyle,
+    cfg: StepLearnConfig,
+    run_dir,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> StepLearnResult:
+    """Learn the gains of ``style`` on ``robot`` (see the module doc), checkpointed in
+    ``run_dir`` after every generation.
+
+    Raises:
+        RunError: ``resume`` without a checkpoint, or with other settings.
+    """
+    from cmaes import CMA
+
+    say = progress or (lambda _msg: None)
+    rd = RunDir(run_dir)
+    rd.path.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    start = MODEL_GAINS
+    log: list[dict] = []
+    if resume and rd.exists("cma.pkl"):
+        with open(rd.file("cma.pkl"), "rb") as fh:
+            saved = pickle.load(fh)
+        if saved["config"] != cfg.to_dict():
+            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        opt, log, spent, wall = saved["cma"], saved["log"], saved["sim_seconds"], saved["wall"]
+        t0 -= wall
+        say(f"learn: resuming after generation {len(log)}")
+    elif resume:
+        raise RunError(f"nothing to resume in {rd.path}: no cma.pkl")
+    else:
+        x0 = start.vector(cfg.names)
+        bounds = np.tile([0.0, 1.0], (len(cfg.names), 1))
+        opt = CMA(mean=x0, sigma=cfg.sigma, bounds=bounds, population_size=cfg.population,
+                  seed=cfg.seed)  # fmt: skip
+        spent = 0.0
+    for gen in range(len(log), cfg.generations):
+        xs = [opt.ask() for _ in range(opt.population_size)]
+        cands = [start.with_vector(cfg.names, x) for x in xs]
+        draws = _robots(cfg.protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
+        scores = _walk_all(cands, draws, robot, style, cfg)
+        costs = [mean_cost(s) for s in scores]
+        spent += sum(r.seconds for s in scores for r in s)
+        opt.tell(list(zip(xs, costs, strict=True)))
+        k = int(np.argmin(costs))
+        falls = [sum(r.fell for r in s) for s in scores]
+        log.append({
+            "generation": gen + 1,
+            "best_cost": costs[k],
+            "mean_cost": float(np.mean(costs)),
+            "best_falls": falls[k],
+            "robots": cfg.robots,
+            "best_gains": cands[k].to_dict(),
+        })  # fmt: skip
+        say(
+            f"learn: generation {gen + 1}/{cfg.generations}: best cost {costs[k]:.3f} "
+            f"({falls[k]}/{cfg.robots} fell), mean {np.mean(costs):.3f}"
+        )
+        state = {"config": cfg.to_dict(), "cma": opt, "log": log, "sim_seconds": spent,
+                 "wall": time.perf_counter() - t0}  # fmt: skip
+        atomic_write(rd.file("cma.pkl"), lambda tmp, s=state: tmp.write_bytes(pickle.dumps(s)))
+        rd.write_log(log)
+    finalists = {"start": start}
+    for entry in log:
+        finalists[f"generation {entry['generation']}"] = StepGains.from_dict(entry["best_gains"])
+    final: dict = {}
+    kept = StepGains.from_dict(min(log, key=lambda e: e["best_cost"])["best_gains"])
+    if cfg.final_robots:
+        draws = _robots(cfg.protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.seconds)
+        names = list(finalists)
+        scores = _walk_all([finalists[n] for n in names], draws, robot, style, cfg)
+        spent += sum(r.seconds for s in scores for r in s)
+        final = {
+            n: {"cost": mean_cost(s), "falls": int(sum(r.fell for r in s))}
+            for n, s in zip(names, scores, strict=True)
+        }
+        best = min(names, key=lambda n: (final[n]["cost"], names.index(n)))
+        kept = finalists[best]
+        say(f"learn: kept {best} ({final[best]['falls']}/{cfg.final_robots} fell on the final robots)")
+    return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)

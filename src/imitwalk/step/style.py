@@ -1,0 +1,172 @@
+"""What the stepping gait imitates: the human's walking style, scaled to the robot's legs.
+
+A :class:`GaitStyle` keeps what imitation keeps of a clip (its
+:class:`~imitwalk.retarget.template.GaitTemplate`): the cadence (the human's step time,
+kept as it is), the stride and the swing foot's clearance (scaled by the robot's leg
+over the human's), the double-support share, the swing foot's path shape (its forward
+progress and lift over the swing), and the arms' and waist's swing over the gait
+phase. The stepping controller (:mod:`imitwalk.step.controller`) walks these as its
+nominal steps and changes them only where the measured state demands it.
+
+What the robot adds is its own: the step width (its hips' spacing), the pelvis height
+(the highest that keeps the knees bent through the longest step,
+:func:`hip_height`), and the limits of its reach (:func:`reach_limits`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from imitwalk.errors import ConfigError
+from imitwalk.retarget.params import LegGeometry
+from imitwalk.retarget.template import GaitTemplate
+
+__all__ = ["KNEE_MIN_DEG", "LIFT_MIN", "GaitStyle", "hip_height", "style_from_template"]
+
+#: The stance knee keeps at least this flexion at the nominal step [deg]: a position-
+#: servoed knee near straight cannot lower or shift the hip, so nothing can balance.
+KNEE_MIN_DEG = 20.0
+#: The least swing clearance, a fraction of the leg (a clip's foot may skim the floor).
+LIFT_MIN = 0.08
+
+
+@dataclass(frozen=True)
+class GaitStyle:
+    """The nominal walk, for one robot.
+
+    Attributes:
+        step_time: one step, touchdown to touchdown [s] (half the human's cycle);
+        double_support: its double-support time [s]; step_length: forward distance
+            between successive feet [m]; step_width: lateral distance between the feet
+            [m]; clearance: the swing foot's peak lift [m]; hip_height: hip centre above
+            the soles [m]; swing_x, swing_z: ``(P,)`` the swing foot's forward progress
+            (0 → 1) and lift (0 → 1 → 0) over the swing; upper: role → ``(P,)`` the arms'
+            and waist's offsets from standing over the gait phase ψ ∈ [0, 1) (ψ = 0 at
+            the left touchdown) [rad]; human: the clip's own figures (``period`` [s],
+            ``stride`` [m], ``leg`` [m], ``speed`` [m/s]) and its ``source``;
+            geometry: the robot's leg measures.
+    """
+
+    step_time: float
+    double_support: float
+    step_length: float
+    step_width: float
+    clearance: float
+    hip_height: float
+    swing_x: np.ndarray
+    swing_z: np.ndarray
+    upper: dict
+    human: dict
+    geometry: LegGeometry
+
+    @property
+    def pelvis_height(self) -> float:
+        """The pelvis frame above the soles [m]."""
+        return self.hip_height + self.geometry.hip_z
+
+    @property
+    def single_support(self) -> float:
+        """Single-support time of a step [s]."""
+        return self.step_time - self.double_support
+
+    @property
+    def speed(self) -> float:
+        """Nominal forward speed [m/s]."""
+        return self.step_length / self.step_time
+
+    def upper_at(self, phase: float) -> dict[str, float]:
+        """The arms' and waist's offsets [rad] at gait phase ``phase`` (wrapped to [0, 1))."""
+        out = {}
+        for role, prof in self.upper.items():
+            x = (phase % 1.0) * len(prof)
+            i = int(x)
+            f = x - i
+            out[role] = float((1.0 - f) * prof[i % len(prof)] + f * prof[(i + 1) % len(prof)])
+        return out
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary (arrays as lists)."""
+        d = asdict(self)
+        d["swing_x"] = self.swing_x.tolist()
+        d["swing_z"] = self.swing_z.tolist()
+        d["upper"] = {k: np.asarray(v).tolist() for k, v in self.upper.items()}
+        d["geometry"] = self.geometry.__dict__.copy()
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GaitStyle:
+        """Inverse of :meth:`to_dict`."""
+        d = dict(d)
+        d["swing_x"] = np.asarray(d["swing_x"], dtype=float)
+        d["swing_z"] = np.asarray(d["swing_z"], dtype=float)
+        d["upper"] = {k: np.asarray(v, dtype=float) for k, v in d["upper"].items()}
+        d["geometry"] = LegGeometry(**d["geometry"])
+        return cls(**d)
+
+
+def hip_height(geom: LegGeometry, step_length: float, knee_min_deg: float = KNEE_MIN_DEG) -> float:
+    """The highest hip centre above the soles [m] at which both legs reach the ground
+    with the knee bent at least ``knee_min_deg`` when the feet are ``step_length`` [m]
+    apart and the hips midway (thigh and shank taken as equal, so a knee bent by κ
+    shortens the leg to ``leg·cos(κ/2)``).
+
+    Raises:
+        ConfigError: the legs cannot make the step at all (which limit says why).
+    """
+    reach = geom.leg * np.cos(np.radians(knee_min_deg) / 2)
+    half = step_length / 2
+    if half >= 0.9 * reach:
+        raise ConfigError(
+            f"a step of {step_length:.3f} m is beyond this robot's legs: with the knee bent "
+            f"{knee_min_deg:g} deg each leg reaches {reach:.3f} m (leg {geom.leg:.3f} m); "
+            "walk a shorter stride (--forward)"
+        )
+    return float(np.sqrt(reach**2 - half**2) + geom.ankle)
+
+
+def style_from_template(
+    template: GaitTemplate, geom: LegGeometry, scale: float = 1.0, forward: float = 1.0
+) -> GaitStyle:
+    """The clip's style on a robot with legs ``geom``, its stride × ``scale`` × ``forward``
+    (``scale`` grows the whole gait's amplitude, arms included; ``forward`` the stride
+    alone)."""
+    if not 0.0 <= scale <= 1.5:
+        raise ConfigError(f"scale {scale:g}: expected 0 <= scale <= 1.5")
+    ratio = geom.leg / template.leg_length
+    import os
+    tscale = np.sqrt(ratio) if os.environ.get("FROUDE") else 1.0
+    step_time = template.period / 2 * tscale
+    ds = float(np.clip(template.double_support, 0.05, 0.3)) * template.period * tscale
+    step_length = scale * forward * template.stride * ratio / 2
+    clearance = max(template.lift * ratio, LIFT_MIN * geom.leg)
+    shape_z = np.maximum(template.swing_z, np.sin(np.pi * np.linspace(0, 1, len(template.swing_z))))
+    shape_z = shape_z / shape_z.max()
+    centred = lambda a: np.asarray(a) - np.mean(a)  # noqa: E731
+    upper = {
+        "l_shoulder_pitch": -scale * centred(template.shoulder[:, 0]),
+        "r_shoulder_pitch": -scale * centred(template.shoulder[:, 1]),
+        "l_elbow": -scale * centred(template.elbow[:, 0]),
+        "r_elbow": -scale * centred(template.elbow[:, 1]),
+        "waist_yaw": scale * np.asarray(template.waist),
+    }
+    return GaitStyle(
+        step_time=float(step_time),
+        double_support=ds,
+        step_length=float(step_length),
+        step_width=float(2 * geom.hip_y),
+        clearance=float(clearance),
+        hip_height=hip_height(geom, max(step_length, 1e-6)),
+        swing_x=np.asarray(template.swing_x, dtype=float),
+        swing_z=shape_z,
+        upper=upper,
+        human={
+            "period": float(template.period),
+            "stride": float(template.stride),
+            "leg": float(template.leg_length),
+            "speed": float(template.speed),
+            "source": str(template.source),
+        },
+        geometry=geom,
+    )
