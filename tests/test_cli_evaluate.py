@@ -8,7 +8,6 @@ import shutil
 
 import pytest
 
-from conftest import TICK, sets
 from imitwalk.cli.main import main
 from imitwalk.judge import pushes
 from imitwalk.runs import RunDir
@@ -107,7 +106,7 @@ def test_learn_refuses_a_setting_out_of_range_before_any_work(tick_reference, tm
 def test_an_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, command):
     out = tmp_path / "taken"
     out.write_text("not a run\n")
-    argv = [command, "--out", str(out)] + (sets(TICK) if command == "learn" else [])
+    argv = [command, "--out", str(out)]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err == f"error: {out} is a file, not a run folder; choose another --out"

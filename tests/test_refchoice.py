@@ -149,7 +149,8 @@ QUICK_LEARN = ["start=0.9", "step=0.1", "iterations=1", "robots=2", "seconds=4",
 
 def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, capsys):
     out = tmp_path / "run"
-    argv = ["learn", "--out", str(out), "--json", *sets([*QUICK_SEARCH, *QUICK_LEARN])]
+    argv = ["learn", "--variant", "extended", "--out", str(out), "--json",
+            *sets([*QUICK_SEARCH, *QUICK_LEARN])]  # fmt: skip
     assert main(argv) == 0
     printed = json.loads(capsys.readouterr().out)
     choice = RunDir(out).read_json("choice.json")
@@ -182,7 +183,8 @@ def _no_wall(choice: dict) -> dict:
 
 def test_an_interrupted_choice_resumes_to_the_same_choice(tmp_path, capsys):
     out = tmp_path / "run"
-    argv = ["learn", "--out", str(out), "--json", *sets([*QUICK_SEARCH, *QUICK_LEARN])]
+    argv = ["learn", "--variant", "extended", "--out", str(out), "--json",
+            *sets([*QUICK_SEARCH, *QUICK_LEARN])]  # fmt: skip
     assert main(argv) == 0
     whole = json.loads(capsys.readouterr().out)["reference_choice"]
     # stopped in pass 2's search, before the choice: pass 1 kept, the rest gone
@@ -223,6 +225,8 @@ def test_a_reference_not_searched_is_learned_once(tmp_path, capsys):
     out = tmp_path / "run"
     argv = [
         "learn",
+        "--variant",
+        "extended",
         "--out",
         str(out),
         "--json",

@@ -37,6 +37,8 @@ def _json_default(v):
 
 _TICK_ONLY = ("trial_scale", "trial_falls", "feedback_gains", "trust", "reference_settings")
 _FAITHFUL_ONLY = ("variant", "gait")
+_STEP_ONLY = ("gains", "final")
+_ONLY = {"tick": _TICK_ONLY, "faithful": _FAITHFUL_ONLY, "step": _STEP_ONLY}
 
 
 @dataclass(frozen=True)
@@ -44,7 +46,8 @@ class LearnSummary:
     """What a learner reached and what it cost: the record behind ``metrics.json``.
 
     Attributes:
-        learner: ``"tick"`` (the per-tick learner) or ``"faithful"`` (the paper's, as written).
+        learner: ``"step"`` (the stepping gait), ``"tick"`` (the per-tick learner) or
+            ``"faithful"`` (the paper's, as written).
         scale_reached: the largest stride scale learned; scales_passed: every scale passed.
         iterations: learning iterations run (schedule iterations for ``tick``).
         sim_seconds_used_for_learning: simulated time of every learning walk [s];
@@ -59,6 +62,8 @@ class LearnSummary:
             (:mod:`imitwalk.retarget.feedforward`), and ``wait``, the load share at which
             its clock waits before a lift-off (0 or absent: none).
         variant: ``faithful``: its variant; gait: ``faithful``: its gait model's report.
+        gains: ``step``: the kept gains, by name (:class:`~imitwalk.step.gains.StepGains`);
+        final: ``step``: each finalist's cost and falls on the final choice's robots.
     """
 
     learner: str
@@ -75,17 +80,20 @@ class LearnSummary:
     reference_settings: dict | None = None
     variant: str | None = None
     gait: dict | None = None
+    gains: dict | None = None
+    final: dict | None = None
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary, without the other learner's fields."""
-        other = _FAITHFUL_ONLY if self.learner == "tick" else _TICK_ONLY
+        other = {k for name, keys in _ONLY.items() if name != self.learner for k in keys}
         return {k: v for k, v in asdict(self).items() if k not in other}
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "metrics.json") -> LearnSummary:
         """The record :meth:`to_dict` wrote; :class:`RunError` naming the missing keys
         if ``d`` (read from ``where``) lacks any."""
-        required = [f.name for f in fields(cls) if f.name not in (*_TICK_ONLY, *_FAITHFUL_ONLY)]
+        optional = {k for keys in _ONLY.values() for k in keys}
+        required = [f.name for f in fields(cls) if f.name not in optional]
         missing = [k for k in required if not isinstance(d, dict) or k not in d]
         if missing:
             raise RunError(f"{where} lacks {', '.join(missing)}: not a finished imitwalk run")

@@ -137,6 +137,9 @@ def learn(args: argparse.Namespace) -> int:
     from imitwalk.runs import RunDir
 
     robot = robot_from(args)
+    args.variant = _variant(args)
+    if args.variant == "step":
+        return _learn_step(args, robot)
     rt_set, learn_set = _split_settings(args.set)
     if args.variant == "faithful":
         from imitwalk.paper.learnconfig import preset
@@ -192,6 +195,74 @@ def learn(args: argparse.Namespace) -> int:
         ref = make_reference()
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
+    return _learned(summary, args, rd)
+
+
+def _variant(args: argparse.Namespace) -> str:
+    """The learner ``learn`` runs: ``--variant`` if given; else the joint-space per-tick
+    learner for a given ``--reference`` or a resumed run that began as one; else the
+    stepping gait."""
+    import json
+
+    if args.variant:
+        return str(args.variant)
+    if args.reference:
+        return "extended"
+    config = Path(args.out) / "config.json"
+    if args.resume and config.is_file():
+        try:
+            learner = json.loads(config.read_text()).get("learner")
+        except (ValueError, AttributeError, OSError):
+            learner = None
+        return {"tick": "extended", "faithful": "faithful"}.get(str(learner), "step")
+    return "step"
+
+
+def _learn_step(args: argparse.Namespace, robot) -> int:
+    """``learn`` with the stepping gait (the default variant)."""
+    from imitwalk.config import apply_overrides
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.runs import RunDir
+    from imitwalk.step.gait import StepGait
+    from imitwalk.step.learn import StepLearnConfig
+    from imitwalk.step.pipeline import gait_from_motion, learn_clip
+
+    if args.reference:
+        raise ConfigError(
+            "--reference is a joint-space reference for --variant extended or faithful; "
+            "the stepping gait learns from the clip itself"
+        )
+    unsupported = [f"--{a}" for a in ("turn", "side", "forward", "slope")
+                   if getattr(args, a, None) is not None]  # fmt: skip
+    if unsupported:
+        raise ConfigError(
+            f"{', '.join(unsupported)}: the stepping gait walks its clip straight ahead on "
+            "level ground; commanded gaits are --variant extended's"
+        )
+    cfg = apply_overrides(StepLearnConfig(seed=args.seed), args.set)
+    protocol = load_protocol(cfg.protocol)
+    rd = RunDir(args.out)
+    rd.check_writable()
+    if args.resume:
+        gait = StepGait.load(rd.file("style.json"))
+        progress(f"learn: resuming {rd.path}")
+    else:
+        motion = _motion(args)
+        progress(f"learn: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
+        gait = gait_from_motion(motion, robot, {"robot": _where(args.robot),
+                                                "joint_map": _where(args.joint_map)})  # fmt: skip
+        st = gait.style
+        progress(
+            f"  style: step {st.step_length:.3f} m every {st.step_time:.2f} s "
+            f"({st.speed:.2f} m/s), width {st.step_width:.3f} m, clearance {st.clearance:.3f} m"
+        )
+    progress(
+        f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "
+        f"(at most {cfg.budget():.0f} simulated seconds)"
+    )
+    summary = learn_clip(gait, robot, cfg, args.out, protocol, resume=args.resume,
+                         progress=progress)  # fmt: skip
     return _learned(summary, args, rd)
 
 

@@ -136,21 +136,23 @@ def build_parser() -> argparse.ArgumentParser:
     pb.set_defaults(func=commands.playback)
     ln = sub.add_parser(
         "learn",
-        help="learn to walk a mocap clip: retarget, learn, search the reference again under "
-        "the learned law, learn again, keep the better on 40 training robots (extended)",
+        help="learn to walk a mocap clip: the clip's style on the robot's legs, a stepping "
+        "gait whose gains are learned on training robots",
     )
     _mocap_args(ln)
     _robot_args(ln, positional=False)
     ln.add_argument("--out", required=True, help="run folder")
     ln.add_argument(
-        "--reference", help="a .npz from retarget, learned as it is (no search, no choice)"
+        "--reference",
+        help="--variant extended or faithful: a .npz from retarget, learned as it is",
     )
     ln.add_argument(
         "--variant",
-        default="extended",
-        choices=("extended", "faithful"),
-        help="extended: per-tick balance learned by trials and the paper's loop (default); "
-        "faithful: the paper as written",
+        default=None,
+        choices=("step", "extended", "faithful"),
+        help="step: the stepping gait, footsteps re-planned every tick (default); extended: "
+        "the joint trajectory replayed with per-tick balance learned by trials and the "
+        "paper's loop (the default with --reference); faithful: the paper as written",
     )
     ln.add_argument("--seed", type=int, default=0, help="random seed (0)")
     ln.add_argument("--resume", action="store_true", help="continue an interrupted run")

@@ -12,7 +12,6 @@ are also saved as ``before_after.mp4`` and ``filmstrip.png``.
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 import time
@@ -20,24 +19,14 @@ from pathlib import Path
 
 from imitwalk.config import schedule_scales
 from imitwalk.evidence import curves, media, plots
+from imitwalk.evidence.page import STYLE, b64, evaluations, figure, img, robustness, section
 from imitwalk.fileio import atomic_write
-from imitwalk.judge import tables
-from imitwalk.judge.records import ProtocolVerdict, PushVerdict
 from imitwalk.judge.replay import LoadedRun, load_run
 from imitwalk.paper.gait import GaitConfig, GaitModel
 from imitwalk.robots import Robot, load_robot
 from imitwalk.runs import RunDir
 
 __all__ = ["write_report"]
-
-
-def _b64(data: bytes) -> str:
-    return base64.b64encode(data).decode("ascii")
-
-
-def _img(fig, alt: str) -> str:
-    png = plots.png_bytes(fig)
-    return f'<img src="data:image/png;base64,{_b64(png)}" alt="{html.escape(alt)}">'
 
 
 def _fmt(v) -> str:
@@ -50,21 +39,6 @@ def _fmt(v) -> str:
     if v is None:
         return "–"
     return html.escape(str(v))
-
-
-STYLE = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}
-img,video{max-width:100%;height:auto;display:block;margin:.5em 0}
-table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;
-text-align:left}.missing{color:#a00}figcaption{font-size:.9em;color:#444;margin-bottom:1em}
-pre{background:#f6f6f6;padding:.5em;overflow:auto}"""
-
-
-def _section(title: str, body: str) -> str:
-    return f"<section><h2>{html.escape(title)}</h2>\n{body}\n</section>\n"
-
-
-def _figure(img: str, caption: str) -> str:
-    return f"<figure>{img}<figcaption>{caption}</figcaption></figure>"
 
 
 def write_report(
@@ -95,6 +69,10 @@ def write_report(
     config = rd.read_json("config.json")
     where = lg.ref.settings.get("robot") or config.get("robot", lg.ref.robot)  # a file, or a name
     robot = robot or load_robot(where, lg.ref.settings.get("joint_map"))
+    if lg.learner == "step":
+        from imitwalk.evidence.step_report import write_step_report
+
+        return write_step_report(run_dir, lg, robot, seconds, progress, s)
     say(f"report: replaying {seconds:g} s at scale {lg.scale:g} (open loop, learned)")
     rp = media.replay(lg, robot, seconds)
     gait = _display_gait(lg)
@@ -107,7 +85,7 @@ def write_report(
     h, w = frames[0].shape[:2]
     video = (
         f'<video controls muted loop playsinline width="{w}" height="{h}" '
-        f'src="data:video/mp4;base64,{_b64(mp4.read_bytes())}"></video>'
+        f'src="data:video/mp4;base64,{b64(mp4.read_bytes())}"></video>'
     )
 
     say("report: rendering film strips and poses")
@@ -117,7 +95,7 @@ def write_report(
             media.robot_strip(renderer, ro, lg.ref.period, s.strip_frames) for _, ro in rp.runs
         ]
         ticks = plots.example_ticks(gait.n_ticks, s.strip_frames)
-        loop = lg.ref.at_scale(rp.scale)[1]  # (N, n)
+        loop = lg.reference.at_scale(rp.scale)[1]  # (N, n)
         poses = [renderer.frame(media.pose_qpos(robot, loop[k])) for k in ticks]
         say("report: replaying and rendering one kick")
         kick = media.kick_strip(renderer, lg, robot, s.strip_frames)
@@ -151,10 +129,10 @@ def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
             (plots.film_strip(images, titles, label), f"film strip: robot {name.split(':')[0]}")
         )
     media.save_strip([f for f, _ in rows], png)
-    out = "".join(_img(f, alt) for f, alt in rows)
+    out = "".join(img(f, alt) for f, alt in rows)
     if missing:
         out = f'<p class="missing">{html.escape(missing)}</p>' + out
-    return _figure(
+    return figure(
         out,
         "Rows: the human demonstration (mocap keypoints, side view), the "
         "robot playing the reference open loop (before), the robot with the learned "
@@ -171,33 +149,7 @@ def _display_gait(lg: LoadedRun) -> GaitModel:
     cfg = lg.metrics.config
     start, step = float(cfg.get("start", 0.3)), float(cfg.get("step", 0.1))
     scales = sorted({*schedule_scales(start, step, max(lg.scale, start)), lg.scale})
-    return GaitModel(lg.ref, scales, GaitConfig())
-
-
-def _evaluations(rd: RunDir) -> str:
-    found = sorted(p.name for p in rd.path.glob("protocol_*.json"))
-    if not found:
-        return (
-            '<p class="missing">No <code>protocol_*.json</code>: run '
-            "<code>imitwalk evaluate RUN --protocol eval</code> (or hard, bullet).</p>"
-        )
-    return "".join(
-        tables.protocol_table(ProtocolVerdict.from_dict(rd.read_json(name), str(rd.file(name))))
-        for name in found
-    )
-
-
-def _robustness(rd: RunDir, kick: tuple) -> str:
-    strip, caption = kick
-    body = _figure(_img(strip, "a kick"), caption)
-    if not rd.exists("push_recovery.json"):
-        return body + (
-            '<p class="missing">No <code>push_recovery.json</code>: run '
-            "<code>imitwalk evaluate RUN --push-recovery</code>.</p>"
-        )
-    name = "push_recovery.json"
-    res = PushVerdict.from_dict(rd.read_json(name), str(rd.file(name)))
-    return _img(curves.push_polar(res), "push recovery") + tables.push_table(res) + body
+    return GaitModel(lg.reference, scales, GaitConfig())
 
 
 def _sections(
@@ -237,12 +189,12 @@ def _sections(
             f"Learned: {media.outcome(rp.after)}.</p>",
         ),
         ("Fig. 8: learning to walk through imitation", fig8),
-        ("Evaluation", _evaluations(rd)),
-        ("Robustness", _robustness(rd, kick)),
+        ("Evaluation", evaluations(rd)),
+        ("Robustness", robustness(rd, kick)),
         (
             "Learning",
-            _figure(
-                _img(learning, "learning curves"),
+            figure(
+                img(learning, "learning curves"),
                 f"{m.iterations} iterations; {m.sim_seconds_used_for_learning:.0f} "
                 f"s simulated; scales passed: {', '.join(f'{p:g}' for p in passed) or 'none'}; "
                 f"{html.escape(media.summary_phrase(m))}.",
@@ -250,24 +202,24 @@ def _sections(
         ),
         (
             "Path",
-            _figure(
-                _img(rp.paths(lg.ref), "torso paths"),
+            figure(
+                img(rp.paths(lg.ref), "torso paths"),
                 f"The replays above from above; dashed: the path the reference commands "
-                f"({lg.ref.gait_command().describe()}).",
+                f"({lg.reference.gait_command().describe()}).",
             ),
         ),
         (
             "Torso gyro",
-            _figure(
-                _img(gyro, "gyro traces"),
+            figure(
+                img(gyro, "gyro traces"),
                 "The replays above, up to just "
                 "after a fall (dashed: the fall); eq. 6 weighs their squares.",
             ),
         ),
         (
             "Fig. 3: posture subspace",
-            _figure(
-                _img(plots.fig3_subspace(gait, scale, poses, ticks), "Fig. 3"),
+            figure(
+                img(plots.fig3_subspace(gait, scale, poses, ticks), "Fig. 3"),
                 "Explained variance: "
                 + ", ".join(f"PC{i + 1} {100 * v:.1f} %" for i, v in enumerate(evr))
                 + ".",
@@ -275,16 +227,16 @@ def _sections(
         ),
         (
             "Fig. 4: embedded action space",
-            _figure(
-                _img(plots.fig4_embedding(gait, scale), "Fig. 4"),
+            figure(
+                img(plots.fig4_embedding(gait, scale), "Fig. 4"),
                 "The frame of eq. 1 and g(φ) of eq. 2.",
             ),
         ),
-        ("Fig. 6: optimised pattern", _figure(_img(fig6, "Fig. 6"), fig6_caption)),
+        ("Fig. 6: optimised pattern", figure(img(fig6, "Fig. 6"), fig6_caption)),
         (
             "Fig. 7: motion pattern scaling",
-            _figure(
-                _img(fig7, "Fig. 7"),
+            figure(
+                img(fig7, "Fig. 7"),
                 "The schedule's scales; red circles: the last cycle the learned "
                 "controller executed above (a faithful run's).",
             ),
@@ -296,4 +248,4 @@ def _sections(
             + "</pre></details>",
         ),
     ]
-    return "".join(_section(t, b) for t, b in sections)
+    return "".join(section(t, b) for t, b in sections)

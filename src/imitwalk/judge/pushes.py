@@ -66,7 +66,11 @@ def _run(path: str):
 
 
 def kick_time(ref, phase: int) -> float:
-    """When [s] the kick at ``phase`` comes: two cycles after the start-up, plus the phase."""
+    """When [s] the kick at ``phase`` comes: two cycles after the start-up, plus the phase
+    (a stepping gait says when its own walk is steady:
+    :meth:`~imitwalk.step.gait.StepGait.kick_time`)."""
+    if hasattr(ref, "kick_time"):
+        return float(ref.kick_time(phase, PHASES))
     n, m = ref.loops.shape[1], ref.starts.shape[1]
     return (m + 2 * n + round(phase * n / PHASES)) * ref.dt
 

@@ -1,10 +1,14 @@
-"""A finished run, loaded to replay: its reference and every controller it can build.
+"""A finished run, loaded to replay: its gait and every controller it can build.
 
-:func:`load_run` reads a run folder of either learner: the per-tick balance learner
-(:mod:`imitwalk.balance.ticklearn`, the default) or the paper's as written (``faithful``,
-:mod:`imitwalk.paper.learner`). Both give a :class:`LoadedRun`: the reference, the scale the
-run reached, the engine it learned on, and :meth:`~LoadedRun.policy`, a fresh
-controller by name. ``open_loop`` (the reference played as it is) is every run's.
+:func:`load_run` reads a run folder of any learner: the stepping gait
+(:mod:`imitwalk.step`, the default), the per-tick balance learner
+(:mod:`imitwalk.balance.ticklearn`) or the paper's as written (``faithful``,
+:mod:`imitwalk.paper.learner`). Each gives a :class:`LoadedRun`: its gait (a stepping
+run's :class:`~imitwalk.step.gait.StepGait`, the others' joint-space reference), the scale
+the run reached, the engine it learned on, and :meth:`~LoadedRun.policy`, a fresh
+controller by name. A stepping run builds ``learned`` and ``default`` (the gains imitwalk
+ships, where learning starts); the others build theirs and ``open_loop`` (the reference
+played as it is).
 """
 
 from __future__ import annotations
@@ -14,12 +18,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.errors import ConfigError, RunError, unknown_name
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import LearnSummary, RunDir
 
 if TYPE_CHECKING:
     from imitwalk.paper.evaluate import LearnedGait
+    from imitwalk.step.gait import StepGait  # noqa: F401  (the annotations' name)
 
 __all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
 
@@ -51,18 +56,37 @@ class LoadedRun:
         :attr:`~imitwalk.runs.LearnSummary.reference_settings`), for its ``learned`` and
         ``feedback`` controllers (``fixed``, the hand-set baseline, and ``open_loop``
         play the reference as it is);
-        gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`).
+        gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`);
+        step_gains: a stepping run's gains by controller name
+        (:class:`~imitwalk.step.gains.StepGains`).
     """
 
     path: str
     learner: str
-    ref: Reference
+    ref: Reference | StepGait
     scale: float
     engine: str
     metrics: LearnSummary
     laws: dict | None = None
     gait: LearnedGait | None = None
     settings: dict | None = None
+    step_gains: dict | None = None
+
+    @property
+    def reference(self) -> Reference:
+        """A joint-space run's reference (a stepping run has none: :attr:`step_gait`)."""
+        if not isinstance(self.ref, Reference):
+            raise RunError(f"{self.path} is a stepping run: it has no joint-space reference")
+        return self.ref
+
+    @property
+    def step_gait(self) -> StepGait:
+        """A stepping run's gait (a joint-space run has none: :attr:`reference`)."""
+        from imitwalk.step.gait import StepGait
+
+        if not isinstance(self.ref, StepGait):
+            raise RunError(f"{self.path} is not a stepping run")
+        return self.ref
 
     def settings_of(self, controller: str) -> dict:
         """How ``controller`` plays the reference: ``feedforward`` and ``wait`` (0: not)."""
@@ -71,7 +95,9 @@ class LoadedRun:
                 "wait": float(mine.get("wait", 0.0))}  # fmt: skip
 
     def controllers(self) -> tuple[str, ...]:
-        """The controllers it can build, ``open_loop`` last."""
+        """The controllers it can build (a joint-space run's ``open_loop`` last)."""
+        if self.step_gains is not None:
+            return tuple(self.step_gains)
         names = tuple(self.laws) if self.laws is not None else ("learned",)
         return (*names, OPEN_LOOP)
 
@@ -79,6 +105,9 @@ class LoadedRun:
         """The first controller that is ``controller``'s exact copy (itself if none is):
         a run whose model-based law was not kept has ``learned`` equal to ``feedback``,
         and a judge walks such a pair once."""
+        if self.step_gains is not None:
+            mine = self.step_gains.get(controller)
+            return next((c for c, g in self.step_gains.items() if g == mine), controller)
         if self.laws is None or controller == OPEN_LOOP:
             return controller
         mine = [law.to_arrays("") for law in self.laws[controller]]
@@ -101,8 +130,15 @@ class LoadedRun:
             ConfigError: a controller this run cannot build (listing the ones it can).
         """
         scale = self.scale if scale is None else scale
+        if self.step_gains is not None:
+            from imitwalk.step.controller import SteppingController
+
+            if controller not in self.step_gains:
+                raise unknown_name("controller", controller, self.controllers(), ConfigError)
+            style = self.step_gait.at_scale(scale)
+            return SteppingController(robot, style, self.step_gains[controller], self.ref.dt)
         if controller == OPEN_LOOP:
-            return _OpenLoop(self.ref, scale, seconds)
+            return _OpenLoop(self.reference, scale, seconds)
         if controller not in self.controllers():
             raise unknown_name("controller", controller, self.controllers(), ConfigError)
         if self.laws is not None:
@@ -110,11 +146,10 @@ class LoadedRun:
             from imitwalk.retarget.feedforward import walk_offsets
 
             s = self.settings_of(controller)
-            offsets = walk_offsets(self.ref, robot, scale, seconds, s["feedforward"])
+            ref = self.reference
+            offsets = walk_offsets(ref, robot, scale, seconds, s["feedforward"])
             laws, names = self.laws[controller], robot.joint_names
-            return TickPolicy(
-                self.ref, scale, laws, names, seconds, offsets=offsets, wait=s["wait"]
-            )
+            return TickPolicy(ref, scale, laws, names, seconds, offsets=offsets, wait=s["wait"])
         assert self.gait is not None  # a faithful run's
         return self.gait.policy(scale)
 
@@ -124,7 +159,23 @@ def load_run(run_dir) -> LoadedRun:
     not one)."""
     rd = RunDir(run_dir)
     config, metrics = rd.read_json("config.json"), rd.read_summary()
+    if not isinstance(config, dict):
+        raise RunError(f"{rd.file('config.json')} is not a run's settings (not a JSON object)")
     engine = str(config.get("learn", {}).get("engine", "mujoco"))
+    if config.get("learner") == "step":
+        from imitwalk.step.gains import StepGains
+        from imitwalk.step.gait import StepGait
+
+        gait = StepGait.load(rd.file("style.json"))
+        saved = rd.read_json("gains.json")
+        try:
+            gains = {name: StepGains.from_dict(saved[name]) for name in ("learned", "default")}
+        except (KeyError, TypeError, ConfigError) as exc:
+            raise RunError(
+                f"{rd.file('gains.json')} is not a stepping run's gains: {exc}"
+            ) from None
+        return LoadedRun(str(rd.path), "step", gait, float(metrics.scale_reached), engine, metrics,
+                         step_gains=gains)  # fmt: skip
     if config.get("learner") == "tick":
         from imitwalk.balance.tickstore import load_laws
 

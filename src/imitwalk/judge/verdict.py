@@ -213,10 +213,13 @@ def judge_protocol(
         for c in controllers:
             saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
     comparison = {}
-    if OPEN_LOOP in by:
-        base = [r.metrics.fell for r in by[OPEN_LOOP]]
+    # each controller against open loop's falls on the same robots (a stepping run, which
+    # has none, against its shipped gains, ``default``)
+    against = OPEN_LOOP if OPEN_LOOP in by else ("default" if "default" in by else None)
+    if against is not None:
+        base = [r.metrics.fell for r in by[against]]
         for c in controllers:
-            if c != OPEN_LOOP:
+            if c != against:
                 comparison[c] = compare_falls([r.metrics.fell for r in by[c]], base)
     return ProtocolVerdict(
         protocol=ProtocolId(protocol.name, protocol.version, protocol.path),

@@ -11,7 +11,15 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["WalkMetrics", "summarise", "tilt_deg", "walk_metrics", "yaw_rad"]
+__all__ = [
+    "GaitTiming",
+    "WalkMetrics",
+    "gait_timing",
+    "summarise",
+    "tilt_deg",
+    "walk_metrics",
+    "yaw_rad",
+]
 
 
 def tilt_deg(quat: np.ndarray) -> np.ndarray:
@@ -162,3 +170,66 @@ def summarise(values: Sequence[float]) -> dict:
     if a.size == 0:
         return {"mean": None, "min": None, "max": None}
     return {"mean": float(a.mean()), "min": float(a.min()), "max": float(a.max())}
+
+
+@dataclass(frozen=True)
+class GaitTiming:
+    """How a walk stepped, from its sole forces alone (what the robot's own sensors say,
+    not the controller's plan).
+
+    Attributes:
+        touchdowns: each foot's touchdown times [s], ``{"l": (...), "r": (...)}``;
+        steps: touchdowns counted over the span measured; cadence_spm: steps per minute;
+        cycle_s: the mean time between two touchdowns of the same foot [s];
+        stride_m: the torso's forward travel per cycle over that span [m] (``None`` if
+        fewer than two cycles were measured).
+    """
+
+    touchdowns: dict
+    steps: int
+    cadence_spm: float | None
+    cycle_s: float | None
+    stride_m: float | None
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        d = asdict(self)
+        d["touchdowns"] = {k: list(v) for k, v in self.touchdowns.items()}
+        return d
+
+
+def gait_timing(
+    rollout, weight_n: float, after_s: float = 0.0, load: float = 0.1, lifted_s: float = 0.08
+) -> GaitTiming:
+    """The touchdowns of a rollout: a sole takes more than ``load`` of ``weight_n`` [N]
+    after it carried almost nothing (under a quarter of that) for at least ``lifted_s``
+    [s] (a swing, not a bounce); cadence and stride are measured over the touchdowns
+    after ``after_s`` [s] (say, once the start-up is over), up to the fall if it fell."""
+    f = np.asarray(rollout.foot_force, dtype=float).sum(axis=2)  # (N, 2)
+    t = np.asarray(rollout.t, dtype=float)
+    end = rollout.fall_time if rollout.fell and rollout.fall_time is not None else np.inf
+    events: dict[str, tuple[float, ...]] = {}
+    for j, side in enumerate("lr"):
+        found, lifted_at = [], None
+        for i in range(len(t)):
+            if f[i, j] < 0.25 * load * weight_n:
+                lifted_at = t[i] if lifted_at is None else lifted_at
+            elif f[i, j] > load * weight_n:
+                if lifted_at is not None and t[i] - lifted_at >= lifted_s and after_s <= t[i] < end:
+                    found.append(float(t[i]))
+                lifted_at = None
+        events[side] = tuple(found)
+    times = sorted(events["l"] + events["r"])
+    if len(times) < 3:
+        return GaitTiming(events, len(times), None, None, None)
+    span = times[-1] - times[0]
+    cadence = 60.0 * (len(times) - 1) / span if span > 0 else None
+    cycles = [np.diff(events[s]) for s in "lr" if len(events[s]) > 1]
+    cycle = float(np.mean(np.concatenate(cycles))) if cycles else None
+    stride = None
+    if cycle is not None and span >= 2 * cycle:
+        i0, i1 = np.searchsorted(t, [times[0], times[-1]])
+        i1 = min(i1, len(t) - 1)
+        travel = float(np.linalg.norm(rollout.torso_pos[i1, :2] - rollout.torso_pos[i0, :2]))
+        stride = travel * cycle / span
+    return GaitTiming(events, len(times), cadence, cycle, stride)

@@ -1,70 +1,92 @@
 """The stepping gait's gains: what learning chooses, each with its valid range.
 
-:class:`StepGains` holds every number of the stepping controller that is not the
-robot's (its MJCF) or the clip's style (:mod:`imitwalk.step.style`). Its defaults,
-:data:`MODEL_GAINS`, are what the linear inverted pendulum alone prescribes (the
-"model" baseline of the tables: follow the plan, no lead, no feedforward); the learner
-(:mod:`imitwalk.step.learn`) chooses them all together with CMA-ES on training robots.
+:class:`StepGains` holds every number of the stepping controller that is neither the
+robot's (its MJCF) nor the clip's style (:mod:`imitwalk.step.style`). Its defaults are
+the gains imitwalk ships, themselves learned: CMA-ES over all of them but ``heading``
+(:mod:`imitwalk.step.learn`; 25 generations of 12 candidates, each walked 10 s on 8
+training robots of the ``hard`` protocol drawn from seed 1001 on, new robots every
+generation; the default clip on ``hoap2``), then the best of the generations' winners
+on 16 fresh robots (``python bench/learn_gains.py OUT``; 17,900 simulated seconds,
+16 minutes on 2 cores). They are the ``default`` controller of every stepping run and
+where ``imitwalk learn`` starts from. ``heading`` is the learner's start, a half.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
+from typing import NamedTuple
 
 import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["BOUNDS", "MODEL_GAINS", "StepGains"]
+__all__ = ["BOUNDS", "GainRange", "StepGains"]
 
-#: Each gain's valid range (inclusive), what it is, and its unit.
-BOUNDS: dict[str, tuple[float, float, str]] = {
-    "dcm": (1.0, 6.0, "the commanded body's ZMP feedback on its DCM error, p = p_plan + dcm (ξ_cmd − ξ_ref) [-]"),
-    "ankle": (0.0, 6.0, "the ankles' ZMP shift on the measured DCM's error from the commanded one [-]"),
-    "follow": (0.0, 0.5, "pull of the commanded centre of mass towards the measured one, per tick [-]"),
-    "lead": (0.0, 0.06, "the centre of mass commanded this far ahead along its velocity [s]"),
-    "step_weight": (-3.0, 1.0, "log10 of the cost of moving a step off its nominal spot [-]"),
-    "zmp_weight": (-3.0, 2.0, "log10 of the cost of the DCM moved by shifting the ZMP within the sole [-]"),
-    "time_weight": (-3.0, 2.0, "log10 of the cost of changing a step's timing [-]"),
-    "unload": (0.05, 1.0, "the trailing foot lifts off once it carries at most this share of the weight [-]"),
-    "ss_min": (0.3, 1.0, "shortest single support, a fraction of the nominal [-]"),
-    "zmp_roll": (0.0, 0.8, "ZMP heel-to-toe travel in single support, a fraction of the half sole [-]"),
-    "zmp_out": (-0.5, 1.0, "the ZMP planned this far outside the sole's centre line, a fraction of the half sole width [-]"),
-    "support": (0.3, 1.0, "the ZMP kept within this fraction of the sole [-]"),
-    "crouch": (0.0, 0.25, "the hip lowered below the style's height, a fraction of the leg [-]"),
-    "heading": (0.0, 1.0, "each step turns this fraction of the heading error back [-]"),
-    "feedforward": (0.0, 1.0, "fraction of the servos' static sag added to their targets [-]"),
-    "torso": (-1.0, 1.0, "the torso's pitch and roll error fed to the stance hip [-]"),
+
+class GainRange(NamedTuple):
+    """A gain's valid range (inclusive) and what it is."""
+
+    lo: float
+    hi: float
+    what: str
+
+
+#: Each gain's valid range and meaning.
+BOUNDS: dict[str, GainRange] = {
+    "dcm": GainRange(1.0, 6.0, "the commanded body's ZMP feedback on its DCM error [-]"),
+    "ankle": GainRange(0.0, 6.0, "the ankles' ZMP shift per metre of measured DCM error [-]"),
+    "follow": GainRange(0.0, 0.5, "the commanded body's pull to the measured one, per tick [-]"),
+    "lead": GainRange(0.0, 0.06, "the centre of mass commanded ahead along its velocity [s]"),
+    "step_weight": GainRange(-3.0, 1.0, "log10 of the cost of moving a step off its spot [-]"),
+    "time_weight": GainRange(-3.0, 2.0, "log10 of the cost of changing a step's timing [-]"),
+    "zmp_weight": GainRange(-3.0, 2.0, "log10 of the cost of the ankles' share of a step [-]"),
+    "unload": GainRange(0.05, 1.0, "the trailing foot lifts at most this share of weight [-]"),
+    "ss_min": GainRange(0.3, 1.0, "the shortest single support, of the style's [-]"),
+    "zmp_roll": GainRange(0.0, 0.8, "the ZMP's heel-to-toe roll, of the half sole [-]"),
+    "zmp_out": GainRange(-0.5, 1.0, "the ZMP outside the sole's centre line, of its half [-]"),
+    "support": GainRange(0.3, 1.0, "the ZMP kept within this share of the sole [-]"),
+    "plan_support": GainRange(0.0, 1.0, "the share of that the step planner counts on [-]"),
+    "crouch": GainRange(0.0, 0.25, "the hips lowered below the style's, of the leg [-]"),
+    "heading": GainRange(0.0, 1.0, "the share of the heading error each step turns back [-]"),
+    "observer": GainRange(-1.0, 1.5, "log10 of the velocity observer's model error [m/s²]"),
+    "swing_fix": GainRange(0.0, 30.0, "the swing sole's measured lag integrated away [1/s]"),
+    "feedforward": GainRange(0.0, 1.0, "the share of the servos' sag and lag fed forward [-]"),
 }
 
 
 @dataclass(frozen=True)
 class StepGains:
-    """The stepping controller's gains (see :data:`BOUNDS` for each one's meaning)."""
+    """The stepping controller's gains (see :data:`BOUNDS` for each one's meaning; the
+    module doc for where the defaults come from)."""
 
-    dcm: float = 2.0
-    ankle: float = 1.0
-    follow: float = 0.0
-    lead: float = 0.0
-    step_weight: float = -1.0
-    time_weight: float = 0.0
-    zmp_weight: float = 0.0
-    unload: float = 0.3
-    ss_min: float = 0.5
-    zmp_roll: float = 0.3
-    zmp_out: float = 0.0
-    support: float = 0.7
-    crouch: float = 0.05
+    dcm: float = 5.142
+    ankle: float = 4.700
+    follow: float = 0.02371
+    lead: float = 0.04417
+    step_weight: float = 0.2370
+    time_weight: float = -0.4532
+    zmp_weight: float = -1.677
+    unload: float = 0.2815
+    ss_min: float = 0.8627
+    zmp_roll: float = 0.2392
+    zmp_out: float = -0.1717
+    support: float = 0.8563
+    plan_support: float = 0.4330
+    crouch: float = 0.05022
     heading: float = 0.5
-    feedforward: float = 1.0
-    torso: float = 0.0
+    observer: float = 0.5923
+    swing_fix: float = 20.16
+    feedforward: float = 0.7141
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
             lo, hi, what = BOUNDS[f.name]
-            if not (isinstance(v, int | float) and np.isfinite(v) and lo <= v <= hi):
-                raise ConfigError(f"gain {f.name}={v!r}: expected {lo:g} <= {f.name} <= {hi:g} ({what})")
+            ok = isinstance(v, int | float) and bool(np.isfinite(v)) and lo <= v <= hi
+            if not ok:
+                raise ConfigError(
+                    f"gain {f.name}={v!r}: expected {lo:g} <= {f.name} <= {hi:g} ({what})"
+                )
 
     def to_dict(self) -> dict[str, float]:
         """Plain dictionary."""
@@ -72,15 +94,24 @@ class StepGains:
 
     @classmethod
     def from_dict(cls, d: dict) -> StepGains:
-        """Gains from a dictionary; unknown names are refused with the valid ones."""
+        """Gains from a dictionary (missing ones at their defaults); an unknown name is
+        refused with the valid ones."""
+        if not isinstance(d, dict):
+            raise ConfigError(
+                f"gains must be a mapping of names to numbers, not {type(d).__name__}"
+            )
         unknown = sorted(set(d) - set(BOUNDS))
         if unknown:
             raise ConfigError(f"unknown gain {unknown[0]!r}; valid gains: {', '.join(BOUNDS)}")
-        return cls(**{k: float(v) for k, v in d.items()})
+        try:
+            return cls(**{k: float(v) for k, v in d.items()})
+        except (TypeError, ValueError):
+            raise ConfigError(f"gains must be numbers: {d}") from None
 
     def vector(self, names: tuple[str, ...]) -> np.ndarray:
         """The gains ``names`` as a vector, each scaled to [0, 1] of its range."""
-        return np.array([(getattr(self, n) - BOUNDS[n][0]) / (BOUNDS[n][1] - BOUNDS[n][0]) for n in names])
+        return np.array([(getattr(self, n) - BOUNDS[n].lo) / (BOUNDS[n].hi - BOUNDS[n].lo)
+                         for n in names])  # fmt: skip
 
     def with_vector(self, names: tuple[str, ...], x: np.ndarray) -> StepGains:
         """These gains with ``names`` set from ``x`` (each in [0, 1] of its range, clipped)."""
@@ -89,7 +120,3 @@ class StepGains:
             lo, hi, _ = BOUNDS[n]
             d[n] = float(lo + (hi - lo) * v)
         return StepGains(**d)
-
-
-#: The gains the pendulum model prescribes alone: the "model" baseline.
-MODEL_GAINS = StepGains()

@@ -76,6 +76,7 @@ class BodyModel:
         self._dadr = np.array([m.jnt_dofadr[m.joint(j).id] for j in robot.mj_joints])
         self._sign = robot.signs.astype(float)
         self.mass = float(m.body_subtreemass[self._root])
+        self.kv = self._servo_damping()
         self.legs = {
             s: robot.indices([f"{s}_{j}" for j in LEG_JOINTS if f"{s}_{j}" in robot.joint_names])
             for s in "lr"
@@ -103,6 +104,19 @@ class BodyModel:
                     self.lo[j] = max(self.lo[j], KNEE_FLOOR)
                 else:
                     self.hi[j] = min(self.hi[j], -KNEE_FLOOR)
+
+    def _servo_damping(self) -> np.ndarray:
+        """``(n,)`` each servo's damping [Nm s/rad]: a position actuator's ``kv``
+        (``-biasprm[2]``) plus its joint's own damping."""
+        m = self.m
+        acts = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
+        out = []
+        for name in self.robot.mj_joints:
+            j = m.joint(name).id
+            a = acts.get(j)
+            kv = -float(m.actuator_biasprm[a, 2]) if a is not None else 0.0
+            out.append(kv + float(m.dof_damping[m.jnt_dofadr[j]]))
+        return np.array(out)
 
     # -- forward kinematics ------------------------------------------------------
     def set(self, q: np.ndarray, root_mat: np.ndarray | None = None) -> None:

@@ -3,7 +3,8 @@
 All of the stepping controller's gains (:class:`~imitwalk.step.gains.StepGains`) that
 :attr:`StepLearnConfig.names` lists are chosen together by the covariance matrix
 adaptation evolution strategy (Hansen, 2016; the ``cmaes`` package) in the unit box of
-their ranges, starting from :data:`~imitwalk.step.gains.MODEL_GAINS`. Each generation
+their ranges, starting from the shipped gains (:class:`~imitwalk.step.gains.StepGains`'s
+defaults). Each generation
 walks every candidate on the same few training robots, drawn from a protocol (``hard``
 by default: friction, mass, servos, a shifted torso, noisy sensors, late servos,
 slopes and kicks) at seeds that no judge uses (from :data:`TRAIN_FIRST`); each
@@ -14,9 +15,9 @@ At the end the best candidate of each generation, and the start, walk the same
 :attr:`StepLearnConfig.final_robots` fresh robots, and the one with the least cost
 there is kept: a generation's winner on five robots is partly luck.
 
-The run folder holds ``cma.pkl`` (the optimiser, its random state included) and
-``log.jsonl`` after every generation, so ``resume`` ends exactly where an
-uninterrupted run would.
+The run folder holds ``cma.pkl`` (the optimiser) and ``log.jsonl`` after every
+generation; the optimiser's random draws are seeded per generation, so ``resume`` ends
+exactly where an uninterrupted run would.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.step.episode import StepJob, StepScore, mean_cost, run_step_job
-from imitwalk.step.gains import BOUNDS, MODEL_GAINS, StepGains
+from imitwalk.step.gains import BOUNDS, StepGains
 from imitwalk.step.style import GaitStyle
 
 __all__ = ["SEARCHED", "TRAIN_FIRST", "StepLearnConfig", "StepLearnResult", "learn_step"]
@@ -43,9 +44,8 @@ __all__ = ["SEARCHED", "TRAIN_FIRST", "StepLearnConfig", "StepLearnResult", "lea
 TRAIN_FIRST = 1001
 #: The final choice's robots, after the generations' ones.
 FINAL_FIRST = 200_001
-#: The gains searched by default: all but the heading's (a slow trim that a few short
-#: walks cannot rank) and the torso's.
-SEARCHED = tuple(n for n in BOUNDS if n not in ("heading", "torso"))
+#: The gains searched by default: all of them.
+SEARCHED = tuple(BOUNDS)
 
 
 @dataclass(frozen=True)
@@ -63,8 +63,8 @@ class StepLearnConfig:
 
     robots: int = 5
     seconds: float = 8.0
-    generations: int = 5
-    population: int = 8
+    generations: int = 4
+    population: int = 6
     sigma: float = 0.15
     protocol: str = "hard"
     names: tuple[str, ...] = SEARCHED
@@ -80,7 +80,7 @@ class StepLearnConfig:
             "robots": self.robots >= 1,
             "seconds": self.seconds > 0,
             "generations": self.generations >= 1,
-            "population": self.population >= 2,
+            "population": self.population >= 4,
             "sigma": 0 < self.sigma <= 1,
             "final_robots": self.final_robots >= 0,
         }
@@ -97,7 +97,9 @@ class StepLearnConfig:
     def budget(self) -> float:
         """Simulated seconds the run walks at most [s]."""
         gen = self.generations * self.population * self.robots * self.seconds
-        final = (self.generations + 1) * self.final_robots * self.seconds if self.final_robots else 0
+        final = (
+            (self.generations + 1) * self.final_robots * self.seconds if self.final_robots else 0
+        )
         return gen + final
 
 
@@ -115,11 +117,8 @@ class StepLearnResult:
     wall_seconds: float = 0.0
 
 
-def _robots(protocol: str, robot: Robot, first: int, count: int, seconds: float):
-    from imitwalk.judge.protocol import load_protocol
-
-    proto = load_protocol(protocol)
-    return [proto.draw(first + i, robot, seconds=seconds) for i in range(count)]
+def _robots(protocol, robot: Robot, first: int, count: int, seconds: float):
+    return [protocol.draw(first + i, robot, seconds=seconds) for i in range(count)]
 
 
 def _walk_all(
@@ -140,11 +139,14 @@ def learn_step(
     style: GaitStyle,
     cfg: StepLearnConfig,
     run_dir,
+    protocol,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> StepLearnResult:
     """Learn the gains of ``style`` on ``robot`` (see the module doc), checkpointed in
-    ``run_dir`` after every generation.
+    ``run_dir`` after every generation; ``protocol`` (a
+    :class:`~imitwalk.judge.protocol.Protocol`, the one ``cfg.protocol`` names) draws
+    the training robots.
 
     Raises:
         RunError: ``resume`` without a checkpoint, or with other settings.
@@ -155,7 +157,7 @@ def learn_step(
     rd = RunDir(run_dir)
     rd.path.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    start = MODEL_GAINS
+    start = StepGains()
     log: list[dict] = []
     if resume and rd.exists("cma.pkl"):
         with open(rd.file("cma.pkl"), "rb") as fh:
@@ -174,9 +176,12 @@ def learn_step(
                   seed=cfg.seed)  # fmt: skip
         spent = 0.0
     for gen in range(len(log), cfg.generations):
+        # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
+        # random state, and a resumed run must draw what an uninterrupted one would
+        opt.reseed_rng(cfg.seed * 100_003 + gen)
         xs = [opt.ask() for _ in range(opt.population_size)]
         cands = [start.with_vector(cfg.names, x) for x in xs]
-        draws = _robots(cfg.protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
+        draws = _robots(protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
         scores = _walk_all(cands, draws, robot, style, cfg)
         costs = [mean_cost(s) for s in scores]
         spent += sum(r.seconds for s in scores for r in s)
@@ -205,7 +210,7 @@ def learn_step(
     final: dict = {}
     kept = StepGains.from_dict(min(log, key=lambda e: e["best_cost"])["best_gains"])
     if cfg.final_robots:
-        draws = _robots(cfg.protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.seconds)
+        draws = _robots(protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.seconds)
         names = list(finalists)
         scores = _walk_all([finalists[n] for n in names], draws, robot, style, cfg)
         spent += sum(r.seconds for s in scores for r in s)
@@ -215,5 +220,6 @@ def learn_step(
         }
         best = min(names, key=lambda n: (final[n]["cost"], names.index(n)))
         kept = finalists[best]
-        say(f"learn: kept {best} ({final[best]['falls']}/{cfg.final_robots} fell on the final robots)")
+        fell = f"{final[best]['falls']}/{cfg.final_robots}"
+        say(f"learn: kept {best} ({fell} fell on the final robots)")
     return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)

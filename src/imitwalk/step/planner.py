@@ -13,12 +13,13 @@ where the DCM at touchdown follows from the DCM now in closed form
 (:func:`~imitwalk.step.lipm.dcm_after`: ``ξ(Δ) = ξ_nom(Δ) + δ (1 − e^{ωΔ})``), ``b_nom`` is
 the nominal DCM offset at touchdown (:class:`~imitwalk.step.lipm.NominalGait`), ``u`` is
 boxed by the leg's reach, the feet kept apart and how far the swing foot can still
-travel in ``Δ``, and ``δ`` by the sole. The ZMP shift is charged by what it moves the DCM at touchdown,
-so that a DCM error is shared between the ankles and the step in the ratio of their
-weights whatever the step's length, until the ZMP reaches the sole's edge. Khadiv et al. fix the ZMP at the sole's centre
-and write the time as ``τ = e^{ωΔ}`` to keep a quadratic program; a slow walk on a small
-robot (``e^{ωT}`` near 20 on hoap2) needs the ankles' share, or every millimetre of DCM
-error at lift-off moves the step by centimetres. Here the time is searched on a grid
+travel in ``Δ``, and ``δ`` by the sole. The ZMP shift is charged by what it moves the
+DCM at touchdown, so that a DCM error is shared between the ankles and the step in the
+ratio of their weights whatever the step's length, until the ZMP reaches the sole's
+edge. Khadiv et al. fix the ZMP at the sole's centre and write the time as
+``τ = e^{ωΔ}`` to keep a quadratic program; a slow walk on a small robot (``e^{ωT}``
+near 20 on hoap2) needs the ankles' share, or every millimetre of DCM error at lift-off
+moves the step by centimetres. Here the time is searched on a grid
 and, for each time, the two-variable box-constrained quadratic per axis is solved by
 exact coordinate descent (a few sweeps, vectorised over the grid).
 

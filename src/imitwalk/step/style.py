@@ -136,6 +136,7 @@ def style_from_template(
         raise ConfigError(f"scale {scale:g}: expected 0 <= scale <= 1.5")
     ratio = geom.leg / template.leg_length
     import os
+
     tscale = np.sqrt(ratio) if os.environ.get("FROUDE") else 1.0
     step_time = template.period / 2 * tscale
     ds = float(np.clip(template.double_support, 0.05, 0.3)) * template.period * tscale

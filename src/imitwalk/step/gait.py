@@ -1,0 +1,135 @@
+"""A stepping run's gait: the style it walks, and what judging and replay need of it.
+
+A per-tick or faithful run judges its walk against its joint-space
+:class:`~imitwalk.retarget.reference.Reference`; a stepping run has no fixed trajectory,
+so :class:`StepGait` answers the same questions (``dt``, ``period``, ``sim_options``,
+``expected_distance``, ``track``, ``trajectory``, ``kick_time``) from the style and the
+controller's nominal schedule (:mod:`imitwalk.step.schedule`), and says where the
+clip came from for the report (``source``, ``cycles``). It is saved as ``style.json``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk.errors import RunError
+from imitwalk.fileio import atomic_write
+from imitwalk.sim.types import SimOptions
+from imitwalk.step.schedule import START_STEPS, nominal_distance, start_seconds
+from imitwalk.step.style import GaitStyle
+
+__all__ = ["StepGait"]
+
+
+@dataclass
+class StepGait:
+    """The gait of a stepping run.
+
+    Attributes:
+        style: the walk at scale 1 (:class:`~imitwalk.step.style.GaitStyle`); robot: the
+        robot's name; dt: the control period [s]; source: the clip; cycles: ``(C, 2)``
+        the clip's frames of the cycles averaged; settings: where the robot came from
+        (``robot``: a built-in name or a joint map's path, ``joint_map``).
+    """
+
+    style: GaitStyle
+    robot: str
+    dt: float = 0.01
+    source: str = ""
+    cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def period(self) -> float:
+        """One gait cycle, two steps [s]."""
+        return 2.0 * self.style.step_time
+
+    def at_scale(self, scale: float) -> GaitStyle:
+        """The style with its stride and arm swing × ``scale`` (the pelvis height and
+        timing as at scale 1)."""
+        st = self.style
+        if scale == 1.0:
+            return st
+        upper = {k: np.asarray(v) * scale for k, v in st.upper.items()}
+        return replace(st, step_length=st.step_length * scale, upper=upper)
+
+    def sim_options(self, base: SimOptions | None = None) -> SimOptions:
+        """``base`` (default options if ``None``) at the control rate of this gait."""
+        base = base or SimOptions()
+        hz = 1.0 / self.dt
+        return base if abs(base.control_hz - hz) < 1e-9 else replace(base, control_hz=hz)
+
+    def start_s(self) -> float:
+        """When the first foot lifts off in the nominal schedule [s]."""
+        return start_seconds(self.style.step_time)
+
+    def expected_distance(self, scale: float, seconds: float) -> float:
+        """Forward travel [m] of the nominal schedule over ``seconds`` from standing
+        (:func:`~imitwalk.step.schedule.nominal_distance`)."""
+        st = self.at_scale(scale)
+        return nominal_distance(st.step_length, st.step_time, seconds)
+
+    def track(self, scale: float, seconds: float) -> np.ndarray:
+        """``(T, 3)`` the commanded forward and sideways travel [m] and heading [rad]
+        per control tick (straight ahead)."""
+        steps = max(1, round(seconds / self.dt))
+        out = np.zeros((steps, 3))
+        out[:, 0] = [self.expected_distance(scale, (k + 1) * self.dt) for k in range(steps)]
+        return out
+
+    def ground_path(self, scale: float, seconds: float) -> np.ndarray:
+        """``(T, 2)`` the commanded path on the ground [m] (straight ahead)."""
+        tr = self.track(scale, seconds)
+        return np.stack([tr[:, 0], tr[:, 1]], axis=1)
+
+    def trajectory(self, scale: float, seconds: float) -> None:
+        """A stepping gait has no fixed joint trajectory: joints are judged against the
+        commanded ones."""
+        return None
+
+    def kick_time(self, phase: int, phases: int) -> float:
+        """When [s] a kick at ``phase`` of ``phases`` comes: four steps after the stride
+        reached the style's, plus that share of a nominal cycle."""
+        return (
+            self.start_s() + (START_STEPS + 4) * self.style.step_time + phase * self.period / phases
+        )
+
+    # -- persistence ------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """Plain-JSON dictionary."""
+        return {
+            "style": self.style.to_dict(),
+            "robot": self.robot,
+            "dt": self.dt,
+            "source": self.source,
+            "cycles": np.asarray(self.cycles, dtype=int).tolist(),
+            "settings": self.settings,
+        }
+
+    def save(self, path: str | Path) -> Path:
+        """Write ``path`` (JSON) atomically."""
+        text = json.dumps(self.to_dict(), indent=1)
+        return atomic_write(path, lambda tmp: tmp.write_text(text + "\n"))
+
+    @classmethod
+    def load(cls, path: str | Path) -> StepGait:
+        """Read a gait :meth:`save` wrote (a one-line :class:`RunError` if it cannot)."""
+        path = Path(path)
+        try:
+            d = json.loads(path.read_text())
+            return cls(
+                style=GaitStyle.from_dict(d["style"]),
+                robot=str(d["robot"]),
+                dt=float(d["dt"]),
+                source=str(d.get("source", "")),
+                cycles=np.asarray(d.get("cycles", []), dtype=int).reshape(-1, 2),
+                settings=dict(d.get("settings", {})),
+            )
+        except FileNotFoundError:
+            raise RunError(f"{path} not found: is {path.parent} a finished imitwalk run?") from None
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+            raise RunError(f"{path} is not a stepping gait: {type(exc).__name__}: {exc}") from None

@@ -1,0 +1,105 @@
+"""A clip to a learned stepping gait, as one library call: the product's ``learn``.
+
+:func:`learn_clip` takes a :class:`~imitwalk.mocap.Motion` and a robot to a finished run
+folder: the clip's gait template (:mod:`imitwalk.retarget.template`), its style on the
+robot's legs (:mod:`imitwalk.step.style`), the gains learned on training robots
+(:mod:`imitwalk.step.learn`), and the run's records:
+
+RUN_DIR/
+  config.json   ``learner: "step"``, the learning settings, the clip
+  style.json    the gait (:class:`~imitwalk.step.gait.StepGait`)
+  cma.pkl       the optimiser after every generation (resume)
+  log.jsonl     one line per generation
+  gains.json    the kept gains and the shipped ones they started from
+  metrics.json  the :class:`~imitwalk.runs.LearnSummary`
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from imitwalk.errors import RunError
+from imitwalk.robots import Robot
+from imitwalk.runs import LearnSummary, RunDir
+from imitwalk.step.gains import StepGains
+from imitwalk.step.gait import StepGait
+from imitwalk.step.learn import StepLearnConfig, learn_step
+
+__all__ = ["gait_from_motion", "learn_clip"]
+
+
+def gait_from_motion(
+    motion, robot: Robot, settings: dict | None = None, dt: float = 0.01
+) -> StepGait:
+    """The :class:`~imitwalk.step.gait.StepGait` of ``motion`` on ``robot`` at scale 1.
+
+    Raises:
+        MocapError: the clip holds no straight, steady walking cycle.
+        ConfigError: the robot's legs cannot make the style's step.
+    """
+    from imitwalk.retarget.ik import leg_geometry
+    from imitwalk.retarget.template import extract_template
+    from imitwalk.step.style import style_from_template
+
+    template = extract_template(motion)
+    style = style_from_template(template, leg_geometry(robot), 1.0)
+    return StepGait(
+        style=style,
+        robot=robot.name,
+        dt=dt,
+        source=str(motion.source),
+        cycles=np.asarray(template.cycles, dtype=int).reshape(-1, 2),
+        settings=dict(settings or {"robot": robot.name, "joint_map": None}),
+    )
+
+
+def learn_clip(
+    gait: StepGait,
+    robot: Robot,
+    cfg: StepLearnConfig,
+    out,
+    protocol,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> LearnSummary:
+    """Learn ``gait`` on ``robot`` into the run folder ``out`` (see the module doc);
+    ``protocol`` draws the training robots (:attr:`StepLearnConfig.protocol`'s).
+
+    Raises:
+        RunError: ``out`` holds another run (without ``resume``), or nothing to resume.
+    """
+    rd = RunDir(out)
+    t0 = time.perf_counter()
+    config = {"learner": "step", "learn": cfg.to_dict(), "robot": robot.name,
+              "source": gait.source}  # fmt: skip
+    if resume:
+        if not rd.exists("style.json"):
+            raise RunError(f"nothing to resume in {rd.path}: no style.json")
+        if rd.read_json("config.json").get("learn") != cfg.to_dict():
+            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        gait = StepGait.load(rd.file("style.json"))
+    else:
+        if rd.exists("config.json") or rd.exists("checkpoint.json"):
+            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        Path(rd.path).mkdir(parents=True, exist_ok=True)
+        rd.write_json("config.json", config)
+        gait.save(rd.file("style.json"))
+    res = learn_step(robot, gait.style, cfg, out, protocol, resume=resume, progress=progress)
+    rd.write_json("gains.json", {"learned": res.gains.to_dict(), "default": StepGains().to_dict()})
+    summary = LearnSummary(
+        learner="step",
+        scale_reached=1.0,
+        scales_passed=[1.0],
+        iterations=len(res.history),
+        sim_seconds_used_for_learning=res.sim_seconds,
+        wall_seconds_for_learning=max(res.wall_seconds, time.perf_counter() - t0),
+        config=cfg.to_dict(),
+        gains=res.gains.to_dict(),
+        final=res.final,
+    )
+    rd.write_json("metrics.json", summary.to_dict())
+    return summary

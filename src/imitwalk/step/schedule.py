@@ -1,0 +1,58 @@
+"""The stepping gait's nominal schedule (pure NumPy): how a walk starts from standing,
+when its steps come, and how far they carry it.
+
+From standing, the controller (:mod:`imitwalk.step.controller`) first settles for
+:data:`SETTLE` step times (the pelvis lowered to its walking height, both feet down),
+then shifts the weight onto the right foot for :data:`SHIFT` step times, then steps,
+the stride growing over the first :data:`START_STEPS` steps to the style's. After that
+a step takes the style's step time. :func:`nominal_distance` is how far this schedule
+carries the body, what a walk's progress is measured against.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "LATE",
+    "SETTLE",
+    "SHIFT",
+    "START_STEPS",
+    "nominal_distance",
+    "start_seconds",
+    "stride_at",
+]
+
+#: Steps over which the stride grows from nothing to the style's.
+START_STEPS = 3
+#: Settling from the standing posture to the walking one, and shifting the weight
+#: onto the first stance foot, in step times.
+SETTLE, SHIFT = 0.6, 1.0
+#: A foot whose floor is late keeps descending for at most this share of a step time,
+#: and a trailing foot that will not unload is lifted after at most that much more.
+LATE = 0.3
+
+
+def start_seconds(step_time: float) -> float:
+    """When the first foot lifts off [s], for steps of ``step_time`` [s]."""
+    return (SETTLE + SHIFT) * step_time
+
+
+def stride_at(step: int, step_length: float) -> float:
+    """The length of step ``step`` (counted from 1) [m]: the style's ``step_length``
+    [m], grown to over :data:`START_STEPS` steps."""
+    return step_length * min(step, START_STEPS) / START_STEPS
+
+
+def nominal_distance(step_length: float, step_time: float, seconds: float) -> float:
+    """Forward travel [m] of the nominal schedule over ``seconds`` from standing: the
+    midpoint of the last two footholds, moved linearly over each step."""
+    n = (seconds - start_seconds(step_time)) / step_time
+    if n <= 0:
+        return 0.0
+    k = int(n)
+    steps = [stride_at(j, step_length) for j in range(1, k + 2)]
+    feet = np.concatenate([[0.0], np.cumsum(steps)])  # footholds after each step
+    mid = 0.5 * (feet[1:] + feet[:-1])  # (k + 1,) midpoints after steps 1 … k + 1
+    before = 0.0 if k == 0 else mid[k - 1]
+    return float(before + (n - k) * (mid[k] - before))

@@ -1,0 +1,114 @@
+"""The stepping gait's robot-side parts: style, gains, kinematics, estimator (real robot)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from imitwalk.errors import ConfigError
+from imitwalk.step.gains import BOUNDS, StepGains
+from imitwalk.step.kinematics import BodyModel, FootPose, rot_z
+from imitwalk.step.style import GaitStyle, hip_height, style_from_template
+
+
+@pytest.fixture(scope="module")
+def template():
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.retarget.template import extract_template
+
+    return extract_template(load_motion(default_clip()))
+
+
+@pytest.fixture(scope="module")
+def geom(robot):
+    from imitwalk.retarget.ik import leg_geometry
+
+    return leg_geometry(robot)
+
+
+def test_the_style_keeps_the_cadence_and_scales_the_stride(template, geom):
+    st = style_from_template(template, geom, 1.0)
+    assert st.step_time == pytest.approx(template.period / 2)
+    assert 2 * st.step_length == pytest.approx(template.stride * geom.leg / template.leg_length)
+    half = style_from_template(template, geom, 0.5)
+    assert half.step_length == pytest.approx(st.step_length / 2)
+    assert half.step_time == st.step_time
+    back = GaitStyle.from_dict(st.to_dict())
+    assert back.step_length == st.step_length and np.array_equal(back.swing_x, st.swing_x)
+    assert back.geometry == st.geometry
+
+
+def test_a_step_beyond_the_legs_is_refused_naming_the_limit(geom):
+    with pytest.raises(ConfigError, match=r"beyond this robot's legs.*--forward"):
+        hip_height(geom, 2.0 * geom.leg)
+
+
+def test_gains_out_of_range_or_unknown_are_refused_with_the_valid_ones():
+    with pytest.raises(ConfigError, match=r"expected 1 <= dcm <= 6"):
+        StepGains(dcm=9.0)
+    with pytest.raises(ConfigError, match="valid gains: dcm, ankle"):
+        StepGains.from_dict({"dmc": 1.0})
+    g = StepGains()
+    names = tuple(BOUNDS)
+    back = g.with_vector(names, g.vector(names)).to_dict()
+    assert back == pytest.approx(g.to_dict())
+
+
+def test_the_leg_ik_reaches_its_targets(robot):
+    body = BodyModel(robot)
+    body.set(robot.stand)
+    feet = {}
+    for s, dx, dz, yaw in (("l", 0.03, 0.02, 0.1), ("r", -0.04, 0.0, -0.05)):
+        feet[s] = FootPose(body.sole_pos(s) + np.array([dx, 0.0, dz]), yaw)
+    q = robot.stand.copy()
+    for _ in range(4):
+        q = body.solve_legs(q, feet, rot_z(0.0), iterations=3)
+    body.set(q)
+    for s, f in feet.items():
+        assert np.linalg.norm(body.sole_pos(s) - f.pos) < 1e-5
+        assert body.sole_yaw(s) == pytest.approx(f.yaw, abs=1e-4)
+    assert np.all(q >= robot.limits[:, 0] - 1e-9) and np.all(q <= robot.limits[:, 1] + 1e-9)
+
+
+def test_static_torques_hold_the_standing_robot(robot):
+    """Torques from the model, with the weight shared by the soles under the centre of
+    mass, equal what holds the standing robot in MuJoCo (its servos at rest)."""
+    body = BodyModel(robot)
+    body.set(robot.stand)
+    com, l, r = body.com(), body.sole_pos("l"), body.sole_pos("r")
+    w = float(np.clip((com[1] - r[1]) / (l[1] - r[1]), 0, 1))
+    point = lambda p: np.array([com[0], p[1], p[2]])  # noqa: E731
+    tau = body.static_torques({"l": (w, point(l)), "r": (1 - w, point(r))})
+    legs = np.concatenate([body.legs["l"], body.legs["r"]])
+    # the robot standing still in MuJoCo: the leg servos' torques once it has settled
+    from imitwalk.sim.mujoco import MujocoPlant
+
+    plant = MujocoPlant(robot)
+    plant.reset()
+    for _ in range(200):
+        plant.command(robot.stand)
+        plant.step()
+    held = plant.torques()
+    assert np.abs(tau[legs] - held[legs]).max() < 0.15  # [Nm], against 4 Nm servos
+
+
+def test_the_estimator_sees_a_robot_standing_still(robot):
+    from imitwalk.sim.mujoco import MujocoPlant
+    from imitwalk.step.estimator import BodyEstimator
+    from imitwalk.step.lipm import omega_of
+
+    body = BodyModel(robot)
+    est = BodyEstimator(body, 0.01, omega_of(0.23))
+    plant = MujocoPlant(robot)
+    obs = plant.reset()
+    for _ in range(100):
+        e = est.update(obs, np.zeros(2))
+        plant.command(robot.stand)
+        obs = plant.step()
+    # the right sole is the stance frame's origin, the left one its width to the left
+    assert e.swing.pos[1] == pytest.approx(2 * 0.039, abs=2e-3)
+    assert abs(e.swing.pos[0]) < 2e-3 and abs(e.swing.yaw) < 1e-2
+    assert e.com[1] == pytest.approx(0.039, abs=5e-3)
+    assert np.linalg.norm(e.com_vel) < 0.01
+    assert np.allclose(e.dcm, e.com[:2], atol=5e-3)
+    assert e.cop is not None and e.cop[1] == pytest.approx(e.com[1], abs=1e-2)

@@ -1,0 +1,112 @@
+"""The stepping gait walking: the controller, learning with resume, the run folder, the CLI."""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+from conftest import sets, strip_wall
+
+#: A tiny learning run: one generation of four candidates on one robot, no final choice.
+TINY_STEP = ["generations=2", "population=4", "robots=1", "seconds=3", "final_robots=1"]
+
+
+@pytest.fixture(scope="module")
+def gait(robot):
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.step.pipeline import gait_from_motion
+
+    return gait_from_motion(load_motion(default_clip()), robot)
+
+
+def test_the_nominal_robot_walks_the_style_from_its_sensors_alone(robot, gait):
+    """Six seconds from standing: no fall, it travels, and the controller was handed
+    nothing but the robot's observations (a plant that exposes nothing else)."""
+    from imitwalk.sim.metrics import walk_metrics
+    from imitwalk.sim.mujoco import MujocoPlant, run
+    from imitwalk.step.controller import SteppingController
+    from imitwalk.step.gains import StepGains
+
+    seen = []
+
+    class Blind:  # the controller sees the Observation only
+        def __init__(self, ctrl):
+            self.ctrl, self.q0 = ctrl, ctrl.q0
+
+        def __call__(self, k, obs):
+            seen.append(type(obs).__name__)
+            return self.ctrl(k, obs)
+
+    ctrl = SteppingController(robot, gait.style, StepGains(), gait.dt)
+    ro = run(MujocoPlant(robot), Blind(ctrl), 600)
+    m = walk_metrics(ro, gait.expected_distance(1.0, ro.seconds))
+    assert not m.fell
+    assert ctrl.steps >= 5
+    assert m.progress_ratio > 0.5 and m.forward_distance_m > 0.2
+    assert set(seen) == {"Observation"}
+
+
+def test_expected_distance_grows_with_the_schedule(gait):
+    d = [gait.expected_distance(1.0, t) for t in np.arange(0, 12, 0.5)]
+    assert d[0] == 0.0 and all(b >= a for a, b in itertools.pairwise(d))
+    steady = gait.expected_distance(1.0, 11.0) - gait.expected_distance(1.0, 9.0)
+    assert steady == pytest.approx(2.0 * gait.style.speed, rel=1e-6)
+
+
+def test_the_gait_saves_and_loads(gait, tmp_path):
+    from imitwalk.errors import RunError
+    from imitwalk.step.gait import StepGait
+
+    back = StepGait.load(gait.save(tmp_path / "style.json"))
+    assert back.to_dict() == gait.to_dict()
+    (tmp_path / "bad.json").write_text("[1, 2]")
+    with pytest.raises(RunError, match="not a stepping gait"):
+        StepGait.load(tmp_path / "bad.json")
+
+
+def test_learning_resumes_exactly(robot, gait, tmp_path):
+    """Two generations straight, and one, interrupted, then resumed: the same gains."""
+    from imitwalk.config import apply_overrides
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.step.learn import StepLearnConfig
+    from imitwalk.step.pipeline import learn_clip
+
+    cfg = apply_overrides(StepLearnConfig(), [*TINY_STEP, "final_robots=0"])
+    one = apply_overrides(cfg, ["generations=1"])
+    proto = load_protocol(cfg.protocol)
+    whole = learn_clip(gait, robot, cfg, tmp_path / "a", proto)
+    learn_clip(gait, robot, one, tmp_path / "b", proto)
+    # the interrupted run's settings said two generations: resume it with those
+    cfg_b = json.loads((tmp_path / "b" / "config.json").read_text())
+    cfg_b["learn"]["generations"] = 2
+    (tmp_path / "b" / "config.json").write_text(json.dumps(cfg_b))
+    import pickle
+
+    state = pickle.loads((tmp_path / "b" / "cma.pkl").read_bytes())
+    state["config"]["generations"] = 2
+    (tmp_path / "b" / "cma.pkl").write_bytes(pickle.dumps(state))
+    resumed = learn_clip(gait, robot, cfg, tmp_path / "b", proto, resume=True)
+    assert resumed.gains == whole.gains
+    assert strip_wall(resumed)["sim_seconds_used_for_learning"] == pytest.approx(
+        whole.sim_seconds_used_for_learning
+    )
+
+
+def test_learn_and_evaluate_a_stepping_run_through_the_cli(tmp_path, capsys):
+    from imitwalk.cli.main import main
+
+    out = tmp_path / "run"
+    assert main(["learn", "--out", str(out), "--json", *sets(TINY_STEP)]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["learner"] == "step" and res["variant"] == "step"
+    assert set(json.loads((out / "gains.json").read_text())) == {"learned", "default"}
+    argv = ["evaluate", str(out), "--seeds", "2", "--seconds", "4", "--json"]
+    assert main(argv) == 0
+    ev = json.loads(capsys.readouterr().out)
+    assert set(ev["controllers"]) == {"learned", "default"}
+    # a stepping run refuses the joint-space learner's flags, in one line
+    assert main(["learn", "--out", str(tmp_path / "x"), "--turn", "10"]) == 2
+    assert "--turn" in capsys.readouterr().err
