@@ -24,7 +24,7 @@ from imitwalk.runs import LearnSummary, RunDir
 
 if TYPE_CHECKING:
     from imitwalk.paper.evaluate import LearnedGait
-    from imitwalk.step.gait import StepGait  # noqa: F401  (the annotations' name)
+    from imitwalk.step.gait import StepGait
 
 __all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
 
