@@ -110,3 +110,37 @@ def test_learn_and_evaluate_a_stepping_run_through_the_cli(tmp_path, capsys):
     # a stepping run refuses the joint-space learner's flags, in one line
     assert main(["learn", "--out", str(tmp_path / "x"), "--turn", "10"]) == 2
     assert "--turn" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        ("population=2", "population=2 is out of range"),
+        ("names=dcm,dmc", "unknown gain 'dmc'"),
+        ("protocol=nope", "unknown protocol 'nope'"),
+        ("robots=x", "expected int"),
+    ],
+)
+def test_bad_learning_settings_are_refused_in_one_line_before_any_work(
+    tmp_path, capsys, setting, message
+):
+    from imitwalk.cli.main import main
+
+    out = tmp_path / "run"
+    assert main(["learn", "--out", str(out), "--set", setting]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and message in err and "\n" not in err
+    assert not out.exists()
+
+
+def test_a_broken_stepping_run_is_refused_in_one_line(tmp_path, capsys):
+    from imitwalk.cli.main import main
+
+    out = tmp_path / "run"
+    assert main(["learn", "--out", str(out), *sets(TINY_STEP)]) == 0
+    capsys.readouterr()
+    (out / "gains.json").write_text('{"learned": {"dcm": "x"}}')
+    assert main(["evaluate", str(out), "--seeds", "1", "--seconds", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("error: ") and "gains.json" in err[-1]
+    assert not any("Traceback" in line for line in err)

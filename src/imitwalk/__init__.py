@@ -10,8 +10,7 @@ MuJoCo)::
     import imitwalk as iw
 
     robot = iw.load_robot("hoap2")
-    ref = iw.retarget(iw.load_motion(iw.default_clip()), robot).reference
-    summary = iw.learn(ref, robot, iw.TickLearnConfig(), "RUN")  # a LearnSummary
+    summary = iw.learn(iw.default_clip(), robot, "RUN")  # what `imitwalk learn` does
     judged = iw.evaluate_run("RUN", robot, iw.load_protocol("eval"), seeds=40)  # a ProtocolVerdict
 """
 
@@ -44,9 +43,14 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "retarget": "imitwalk.retarget",
     "RetargetConfig": "imitwalk.retarget",
     "Reference": "imitwalk.retarget",
+    "learn": "imitwalk.step.pipeline",
+    "gait_from_motion": "imitwalk.step.pipeline",
+    "StepGait": "imitwalk.step.gait",
+    "StepGains": "imitwalk.step.gains",
+    "StepLearnConfig": "imitwalk.step.learn",
+    "SteppingController": "imitwalk.step.controller",
     "TickLearnConfig": "imitwalk.balance.tickconfig",
     "learn_tick": "imitwalk.balance.ticklearn",
-    "learn": ("imitwalk.balance.ticklearn", "learn_tick"),
     "learn_clip": "imitwalk.balance.refchoice",
     "load_run": "imitwalk.judge.replay",
     "evaluate_run": ("imitwalk.judge.verdict", "judge_protocol"),

@@ -224,9 +224,8 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
     from imitwalk.errors import ConfigError
     from imitwalk.judge.protocol import load_protocol
     from imitwalk.runs import RunDir
-    from imitwalk.step.gait import StepGait
     from imitwalk.step.learn import StepLearnConfig
-    from imitwalk.step.pipeline import gait_from_motion, learn_clip
+    from imitwalk.step.pipeline import learn
 
     if args.reference:
         raise ConfigError(
@@ -241,28 +240,21 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
             "level ground; commanded gaits are --variant extended's"
         )
     cfg = apply_overrides(StepLearnConfig(seed=args.seed), args.set)
-    protocol = load_protocol(cfg.protocol)
+    load_protocol(cfg.protocol)  # an unknown one refused before any work
     rd = RunDir(args.out)
     rd.check_writable()
+    motion = None
     if args.resume:
-        gait = StepGait.load(rd.file("style.json"))
         progress(f"learn: resuming {rd.path}")
     else:
         motion = _motion(args)
         progress(f"learn: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
-        gait = gait_from_motion(motion, robot, {"robot": _where(args.robot),
-                                                "joint_map": _where(args.joint_map)})  # fmt: skip
-        st = gait.style
-        progress(
-            f"  style: step {st.step_length:.3f} m every {st.step_time:.2f} s "
-            f"({st.speed:.2f} m/s), width {st.step_width:.3f} m, clearance {st.clearance:.3f} m"
-        )
     progress(
         f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "
         f"(at most {cfg.budget():.0f} simulated seconds)"
     )
-    summary = learn_clip(gait, robot, cfg, args.out, protocol, resume=args.resume,
-                         progress=progress)  # fmt: skip
+    where = {"robot": _where(args.robot), "joint_map": _where(args.joint_map)}
+    summary = learn(motion, robot, args.out, cfg, args.resume, progress, where)
     return _learned(summary, args, rd)
 
 

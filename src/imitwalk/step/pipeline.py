@@ -29,7 +29,7 @@ from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
 
-__all__ = ["gait_from_motion", "learn_clip"]
+__all__ = ["gait_from_motion", "learn", "learn_clip"]
 
 
 def gait_from_motion(
@@ -103,3 +103,44 @@ def learn_clip(
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary
+
+
+def learn(
+    clip=None,
+    robot: Robot | str = "hoap2",
+    out="RUN",
+    cfg: StepLearnConfig | None = None,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+    settings: dict | None = None,
+) -> LearnSummary:
+    """The product as one call: ``clip`` learned as a stepping gait on ``robot`` into the
+    run folder ``out``, exactly as ``imitwalk learn CLIP --out OUT`` does.
+
+    Args:
+        clip: a :class:`~imitwalk.mocap.Motion`, a mocap file's path, or ``None`` (the
+            embedded walk); robot: a :class:`~imitwalk.robots.Robot` or its name or
+            file; cfg: the learning settings (default :class:`StepLearnConfig`);
+            resume: continue an interrupted run (its clip and gait are its own);
+            settings: where the robot came from, for the run folder (``robot``,
+            ``joint_map``; default: its name).
+    """
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.mocap import Motion, default_clip, load_motion
+    from imitwalk.robots import load_robot
+
+    robot = load_robot(robot) if isinstance(robot, str) else robot
+    cfg = cfg or StepLearnConfig()
+    protocol = load_protocol(cfg.protocol)
+    if resume:
+        gait = StepGait.load(RunDir(out).file("style.json"))
+    else:
+        motion = clip if isinstance(clip, Motion) else load_motion(clip or default_clip())
+        gait = gait_from_motion(motion, robot, settings)
+        st = gait.style
+        if progress is not None:
+            progress(
+                f"  style: a {st.step_length:.3f} m step every {st.step_time:.2f} s "
+                f"({st.speed:.2f} m/s), {st.step_width:.3f} m wide, {st.clearance:.3f} m high"
+            )
+    return learn_clip(gait, robot, cfg, out, protocol, resume=resume, progress=progress)
