@@ -1,7 +1,8 @@
 """How the stepping gait's shipped gains were learned (``StepGains``'s defaults).
 
-CMA-ES over every gain but ``heading`` from a start of your choice (default: the
-shipped gains themselves), on the default clip and ``hoap2``: ``--generations``
+CMA-ES over every gain but ``heading`` from the shipped gains (or ``--start``), on
+``hoap2`` walking the clips given (default: the embedded one; the training robots take
+them in turn): ``--generations``
 generations of ``--population`` candidates, each walked ``--seconds`` on ``--robots``
 training robots of the ``hard`` protocol (seeds from 1001, new ones every generation),
 then the best of the generations' winners on ``--final`` fresh robots. Checkpointed in
@@ -10,7 +11,8 @@ OUT after every generation (``--resume``). The shipped gains came from
 run of an earlier revision, resumed: the optimiser's draws after the resume differ from
 an uninterrupted run's, so a rerun learns gains of the same quality, not the same gains).
 
-Usage: ``python bench/learn_gains.py OUT [--resume] [--start GAINS.json]``; prints JSON.
+Usage: ``python bench/learn_gains.py OUT [CLIP ...] [--resume] [--start GAINS.json]``;
+prints JSON.
 """
 
 from __future__ import annotations
@@ -29,7 +31,9 @@ from imitwalk.step.pipeline import gait_from_motion
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
+    ap.add_argument("clips", nargs="*", help="mocap files (default: the embedded walk)")
     ap.add_argument("--resume", action="store_true")
+    ap.add_argument("--start", help="a JSON file of gains to start from (default: shipped)")
     ap.add_argument("--generations", type=int, default=25)
     ap.add_argument("--population", type=int, default=12)
     ap.add_argument("--robots", type=int, default=8)
@@ -38,13 +42,14 @@ def main() -> None:
     ap.add_argument("--sigma", type=float, default=0.2)
     args = ap.parse_args()
     robot = load_robot("hoap2")
-    gait = gait_from_motion(load_motion(default_clip()), robot)
+    styles = [gait_from_motion(load_motion(c), robot).style for c in args.clips or [default_clip()]]
     names = tuple(n for n in BOUNDS if n != "heading")
     cfg = StepLearnConfig(robots=args.robots, seconds=args.seconds, generations=args.generations,
                           population=args.population, sigma=args.sigma, names=names,
                           final_robots=args.final)  # fmt: skip
-    res = learn_step(robot, gait.style, cfg, args.out, load_protocol(cfg.protocol),
-                     resume=args.resume, progress=print)  # fmt: skip
+    start = StepGains.from_dict(json.loads(open(args.start).read())) if args.start else None
+    res = learn_step(robot, styles, cfg, args.out, load_protocol(cfg.protocol),
+                     resume=args.resume, progress=print, start=start)  # fmt: skip
     out = {"gains": res.gains.to_dict(), "shipped": StepGains().to_dict(), "final": res.final,
            "sim_seconds": res.sim_seconds, "wall_seconds": res.wall_seconds}  # fmt: skip
     print(json.dumps(out, indent=2))

@@ -193,7 +193,7 @@ class SteppingController:
         self.land_yaw = float(np.clip(g.heading * err, -0.35, 0.35))
         if self.single:
             self.swing.advance(self.t_phase, self.ss, self.landing, self.land_yaw,
-                               e.swing.pos, dt)  # fmt: skip
+                               e.swing.pos, dt, e.slope)  # fmt: skip
         q = self._joints(e)
         if self.log:
             self.ticks.append(

@@ -31,6 +31,8 @@ from imitwalk.step.lipm import GRAVITY
 __all__ = ["BodyEstimate", "BodyEstimator", "ObserverNoise", "observer_gain"]
 
 SIDES = ("l", "r")
+#: The floor's slope is smoothed with this time constant [s].
+SLOPE_TAU = 0.3
 
 
 @dataclass(frozen=True)
@@ -78,6 +80,8 @@ class BodyEstimate:
         cop: ``(2,)`` the centre of pressure [m] (``None``: nothing touches);
         load: ``(2,)`` the total sole force under the left and right foot [N];
         heading: the stance sole's heading in the start frame [rad];
+        slope: ``(2,)`` the floor's rise per metre along x and y under the stance sole
+        (its attitude from the IMU and the encoders, smoothed over :data:`SLOPE_TAU`);
         roll, pitch: the torso's tilt [rad].
     """
 
@@ -88,6 +92,7 @@ class BodyEstimate:
     cop: np.ndarray | None
     load: np.ndarray
     heading: float
+    slope: np.ndarray
     roll: float
     pitch: float
 
@@ -122,6 +127,7 @@ class BodyEstimator:
         self._tilt.reset()
         self.stance = stance
         self._x: np.ndarray | None = None  # (2, 2): per axis [c, ċ]
+        self._slope = np.zeros(2)  # the floor's dz/dx, dz/dy under the stance sole
         self._frame: tuple[np.ndarray, float] | None = None
 
     def _pose(self, obs) -> tuple[np.ndarray, np.ndarray, float]:
@@ -138,6 +144,10 @@ class BodyEstimator:
         sole_mat = world @ b.sole_mat(st) @ b._flat[st].T
         heading = float(np.arctan2(sole_mat[1, 0], sole_mat[0, 0]))
         to_stance = rot_z(-heading) @ world
+        # the floor's slope under the stance sole (its normal), in the stance frame
+        normal = rot_z(-heading) @ sole_mat[:, 2]
+        slope = -normal[:2] / max(float(normal[2]), 0.5)
+        self._slope += min(self.dt / SLOPE_TAU, 1.0) * (slope - self._slope)
         return to_stance, b.sole_pos(st), heading
 
     def update(self, obs, zmp_hint: np.ndarray) -> BodyEstimate:
@@ -172,6 +182,7 @@ class BodyEstimator:
             cop=cop,
             load=load,
             heading=heading,
+            slope=self._slope.copy(),
             roll=float(tilt.roll),
             pitch=float(tilt.pitch),
         )
@@ -180,9 +191,10 @@ class BodyEstimator:
         """The swing foot landed at ``landing`` (in the old stance frame) and becomes the
         stance foot: re-express the observer's state in its frame."""
         self.stance = new_stance
+        r = rot_z(-landing.yaw)[:2, :2]
+        self._slope = r @ self._slope
         if self._x is None:
             return
-        r = rot_z(-landing.yaw)[:2, :2]
         c = (self._x[:, 0] - landing.pos[:2]) @ r.T
         v = self._x[:, 1] @ r.T
         self._x = np.stack([c, v], axis=1)

@@ -122,12 +122,13 @@ def _robots(protocol, robot: Robot, first: int, count: int, seconds: float):
 
 
 def _walk_all(
-    candidates: list[StepGains], draws, robot: Robot, style: GaitStyle, cfg: StepLearnConfig
+    candidates: list[StepGains], draws, robot: Robot, styles: list[GaitStyle], cfg: StepLearnConfig
 ) -> list[list[StepScore]]:
+    """Every candidate on every robot; robot ``i`` walks ``styles[i % len(styles)]``."""
     jobs = [
-        StepJob(robot, style, g, d.seed, d.options, cfg.seconds, cfg.engine)
+        StepJob(robot, styles[i % len(styles)], g, d.seed, d.options, cfg.seconds, cfg.engine)
         for g in candidates
-        for d in draws
+        for i, d in enumerate(draws)
     ]
     res = run_parallel(run_step_job, jobs)
     n = len(draws)
@@ -136,17 +137,20 @@ def _walk_all(
 
 def learn_step(
     robot: Robot,
-    style: GaitStyle,
+    style: GaitStyle | list[GaitStyle],
     cfg: StepLearnConfig,
     run_dir,
     protocol,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
+    start: StepGains | None = None,
 ) -> StepLearnResult:
-    """Learn the gains of ``style`` on ``robot`` (see the module doc), checkpointed in
+    """Learn the gains of ``style`` on ``robot`` (see the module doc; a list of styles:
+    the training robots take them in turn), checkpointed in
     ``run_dir`` after every generation; ``protocol`` (a
     :class:`~imitwalk.judge.protocol.Protocol`, the one ``cfg.protocol`` names) draws
-    the training robots.
+    the training robots; ``start``: where the search starts (default: the shipped
+    gains).
 
     Raises:
         RunError: ``resume`` without a checkpoint, or with other settings.
@@ -154,10 +158,11 @@ def learn_step(
     from cmaes import CMA
 
     say = progress or (lambda _msg: None)
+    styles = list(style) if isinstance(style, list) else [style]
     rd = RunDir(run_dir)
     rd.path.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    start = StepGains()
+    start = start or StepGains()
     log: list[dict] = []
     if resume and rd.exists("cma.pkl"):
         with open(rd.file("cma.pkl"), "rb") as fh:
@@ -182,7 +187,7 @@ def learn_step(
         xs = [opt.ask() for _ in range(opt.population_size)]
         cands = [start.with_vector(cfg.names, x) for x in xs]
         draws = _robots(protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
-        scores = _walk_all(cands, draws, robot, style, cfg)
+        scores = _walk_all(cands, draws, robot, styles, cfg)
         costs = [mean_cost(s) for s in scores]
         spent += sum(r.seconds for s in scores for r in s)
         opt.tell(list(zip(xs, costs, strict=True)))
@@ -212,7 +217,7 @@ def learn_step(
     if cfg.final_robots:
         draws = _robots(protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.seconds)
         names = list(finalists)
-        scores = _walk_all([finalists[n] for n in names], draws, robot, style, cfg)
+        scores = _walk_all([finalists[n] for n in names], draws, robot, styles, cfg)
         spent += sum(r.seconds for s in scores for r in s)
         final = {
             n: {"cost": mean_cost(s), "falls": int(sum(r.fell for r in s))}

@@ -49,10 +49,12 @@ class SwingFoot:
         self.fix = np.zeros(3)
 
     def advance(self, elapsed: float, duration: float, landing: np.ndarray, yaw: float,
-                measured: np.ndarray, dt: float) -> FootPose:  # fmt: skip
+                measured: np.ndarray, dt: float, slope=(0.0, 0.0)) -> FootPose:  # fmt: skip
         """Move the foot for the tick ending ``elapsed`` [s] into a swing of ``duration``
         [s] towards ``landing`` ``(2,)`` [m] and heading ``yaw`` [rad]; ``measured``
-        ``(3,)``: where the encoders put the sole [m]. Returns the foot's planned pose."""
+        ``(3,)``: where the encoders put the sole [m]; ``slope``: the floor's rise per
+        metre along x and y (the lift is over the floor under the foot). Returns the
+        foot's planned pose."""
         s = min(elapsed / max(duration, 1e-3), 1.0)
         x0, x1 = _profile(self.shape_x, self.sigma), _profile(self.shape_x, s)
         frac = 1.0 if 1.0 - x0 < 1e-6 else (x1 - x0) / (1.0 - x0)
@@ -60,11 +62,12 @@ class SwingFoot:
         pos = self.pose.pos.copy()
         pos[:2] += frac * (landing - pos[:2])
         turned = self.pose.yaw + frac * (yaw - self.pose.yaw)
+        floor = float(slope[0] * pos[0] + slope[1] * pos[1])
         if s < 1.0:
-            pos[2] = self.clearance * _profile(self.shape_z, s)
+            pos[2] = floor + self.clearance * _profile(self.shape_z, s)
         else:  # the floor is late: keep descending
             down = 0.5 * self.clearance * dt / self.late_s
-            pos[2] = max(pos[2] - down, -0.5 * self.clearance)
+            pos[2] = max(pos[2] - down, floor - 0.5 * self.clearance)
         self.pose, self.sigma = FootPose(pos, turned), s
         self.fix = np.clip(self.fix + self.rate * dt * (pos - measured), -self.limit, self.limit)
         return self.pose
