@@ -25,7 +25,12 @@ def measure(path: str, seconds: float) -> dict:
     ro = run(make_plant(robot, gait.sim_options()), lr.policy("learned", robot, 1.0, seconds),
              round(seconds / gait.dt))  # fmt: skip
     m = walk_metrics(ro, gait.expected_distance(1.0, ro.seconds))
-    timing = gait_timing(ro, robot.total_mass * 9.81, after_s=gait.kick_time(0, 1) - gait.period)
+    timing = gait_timing(
+        ro,
+        robot.total_mass * 9.81,
+        after_s=gait.kick_time(0, 1) - gait.period,
+        lifted_s=0.5 * st.single_support,
+    )
     human = st.human
     speed = None if timing.stride_m is None else timing.stride_m / timing.cycle_s
     out = {
@@ -36,7 +41,7 @@ def measure(path: str, seconds: float) -> dict:
         "style": {"cadence_spm": 60.0 / st.step_time, "stride_m": 2 * st.step_length,
                   "speed_mps": st.speed, "leg_m": st.geometry.leg},
         "robot": {"cadence_spm": timing.cadence_spm, "stride_m": timing.stride_m,
-                  "speed_mps": speed, "steps": timing.steps},
+                  "speed_mps": speed, "steps": timing.steps, "scuffs": timing.scuffs},
     }  # fmt: skip
     rob, sty = out["robot"], out["style"]
     out["ratios"] = {

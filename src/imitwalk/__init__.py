@@ -30,7 +30,7 @@ from imitwalk.errors import (
     RunError,
 )
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 #: The flat API: name -> the module that defines it, or (module, its name there); each is
 #: imported on first use.

@@ -52,7 +52,8 @@ def imitation_rows(lg: LoadedRun, ro: Rollout, robot: Robot) -> list[tuple[str, 
     gait = lg.step_gait
     st, human = gait.at_scale(lg.scale), gait.style.human
     after = gait.kick_time(0, 1) - gait.period
-    timing = gait_timing(ro, robot.total_mass * 9.81, after_s=after)
+    weight = robot.total_mass * 9.81
+    timing = gait_timing(ro, weight, after_s=after, lifted_s=0.5 * st.single_support)
     speed = None
     if timing.stride_m is not None and timing.cycle_s:
         speed = timing.stride_m / timing.cycle_s
@@ -63,6 +64,7 @@ def imitation_rows(lg: LoadedRun, ro: Rollout, robot: Robot) -> list[tuple[str, 
          _fmt(timing.stride_m, ".3f")),
         ("speed [m/s]", _fmt(human["speed"], ".2f"), _fmt(st.speed, ".3f"), _fmt(speed, ".3f")),
         ("leg [m]", _fmt(human["leg"], ".3f"), _fmt(st.geometry.leg, ".3f"), ""),
+        ("toe scuffs mid-swing", "", "0", str(timing.scuffs)),
     ]  # fmt: skip
 
 

@@ -172,6 +172,10 @@ def summarise(values: Sequence[float]) -> dict:
     return {"mean": float(a.mean()), "min": float(a.min()), "max": float(a.max())}
 
 
+#: A sole lifted for less than this [s] and back down is a bounce at lift-off, not a step.
+BOUNCE_S = 0.05
+
+
 @dataclass(frozen=True)
 class GaitTiming:
     """How a walk stepped, from its sole forces alone (what the robot's own sensors say,
@@ -179,6 +183,8 @@ class GaitTiming:
 
     Attributes:
         touchdowns: each foot's touchdown times [s], ``{"l": (...), "r": (...)}``;
+        scuffs: touches of a sole lifted for less than a swing but more than a bounce
+            (:data:`BOUNCE_S`): a toe catching the floor;
         steps: touchdowns counted over the span measured; cadence_spm: steps per minute;
         cycle_s: the mean time between two touchdowns of the same foot [s];
         stride_m: the torso's forward travel per cycle over that span [m] (``None`` if
@@ -186,6 +192,7 @@ class GaitTiming:
     """
 
     touchdowns: dict
+    scuffs: int
     steps: int
     cadence_spm: float | None
     cycle_s: float | None
@@ -203,25 +210,30 @@ def gait_timing(
 ) -> GaitTiming:
     """The touchdowns of a rollout: a sole takes more than ``load`` of ``weight_n`` [N]
     after it carried almost nothing (under a quarter of that) for at least ``lifted_s``
-    [s] (a swing, not a bounce); cadence and stride are measured over the touchdowns
-    after ``after_s`` [s] (say, once the start-up is over), up to the fall if it fell."""
+    [s] (a swing; a shorter lift is a scuff, counted apart); cadence and stride are
+    measured over the touchdowns after ``after_s`` [s] (say, once the start-up is
+    over), up to the fall if it fell."""
     f = np.asarray(rollout.foot_force, dtype=float).sum(axis=2)  # (N, 2)
     t = np.asarray(rollout.t, dtype=float)
     end = rollout.fall_time if rollout.fell and rollout.fall_time is not None else np.inf
     events: dict[str, tuple[float, ...]] = {}
+    scuffs = 0
     for j, side in enumerate("lr"):
         found, lifted_at = [], None
         for i in range(len(t)):
             if f[i, j] < 0.25 * load * weight_n:
                 lifted_at = t[i] if lifted_at is None else lifted_at
             elif f[i, j] > load * weight_n:
-                if lifted_at is not None and t[i] - lifted_at >= lifted_s and after_s <= t[i] < end:
-                    found.append(float(t[i]))
+                if lifted_at is not None and after_s <= t[i] < end:
+                    if t[i] - lifted_at >= lifted_s:
+                        found.append(float(t[i]))
+                    elif t[i] - lifted_at >= BOUNCE_S:
+                        scuffs += 1
                 lifted_at = None
         events[side] = tuple(found)
     times = sorted(events["l"] + events["r"])
     if len(times) < 3:
-        return GaitTiming(events, len(times), None, None, None)
+        return GaitTiming(events, scuffs, len(times), None, None, None)
     span = times[-1] - times[0]
     cadence = 60.0 * (len(times) - 1) / span if span > 0 else None
     cycles = [np.diff(events[s]) for s in "lr" if len(events[s]) > 1]
@@ -232,4 +244,4 @@ def gait_timing(
         i1 = min(i1, len(t) - 1)
         travel = float(np.linalg.norm(rollout.torso_pos[i1, :2] - rollout.torso_pos[i0, :2]))
         stride = travel * cycle / span
-    return GaitTiming(events, len(times), cadence, cycle, stride)
+    return GaitTiming(events, scuffs, len(times), cadence, cycle, stride)

@@ -33,13 +33,16 @@ class SwingFoot:
         shape_x, shape_z: ``(P,)`` the style's forward progress and lift profiles;
         clearance: the peak lift [m]; late_s: how long a late floor is waited for [s];
         rate: how fast the sole's measured lag is integrated away [1/s]; limit: that
-        correction's bound per axis [m].
+        correction's bound per axis [m]; lead_s: the lift is commanded this far ahead of
+        its time as the foot leaves the floor [s] (the servos' lag, so that the toe
+        clears the floor on time), the lead fading out by mid-swing.
     """
 
     def __init__(self, shape_x, shape_z, clearance: float, late_s: float, rate: float,
-                 limit: float):  # fmt: skip
+                 limit: float, lead_s: float = 0.0):  # fmt: skip
         self.shape_x, self.shape_z = np.asarray(shape_x), np.asarray(shape_z)
         self.clearance, self.late_s, self.rate, self.limit = clearance, late_s, rate, limit
+        self.lead_s = lead_s
         self.lift_off(FootPose(np.zeros(3), 0.0))
 
     def lift_off(self, pose: FootPose) -> None:
@@ -53,8 +56,8 @@ class SwingFoot:
         """Move the foot for the tick ending ``elapsed`` [s] into a swing of ``duration``
         [s] towards ``landing`` ``(2,)`` [m] and heading ``yaw`` [rad]; ``measured``
         ``(3,)``: where the encoders put the sole [m]; ``slope``: the floor's rise per
-        metre along x and y (the lift is over the floor under the foot). Returns the
-        foot's planned pose."""
+        metre along x and y (the lift is over the floor, from the lift-off spot's height
+        to the landing's as the foot progresses). Returns the foot's planned pose."""
         s = min(elapsed / max(duration, 1e-3), 1.0)
         x0, x1 = _profile(self.shape_x, self.sigma), _profile(self.shape_x, s)
         frac = 1.0 if 1.0 - x0 < 1e-6 else (x1 - x0) / (1.0 - x0)
@@ -62,9 +65,14 @@ class SwingFoot:
         pos = self.pose.pos.copy()
         pos[:2] += frac * (landing - pos[:2])
         turned = self.pose.yaw + frac * (yaw - self.pose.yaw)
-        floor = float(slope[0] * pos[0] + slope[1] * pos[1])
+        # the floor under the foot: the lift-off spot's at first, the landing's at the end
+        floor = x1 * float(slope[0] * landing[0] + slope[1] * landing[1])
         if s < 1.0:
-            pos[2] = floor + self.clearance * _profile(self.shape_z, s)
+            # the lift ahead of its time while it rises, the lead fading out by mid-swing
+            # so that the descent, and so the touchdown, keep their time
+            lead = self.lead_s / max(duration, 1e-3) * max(0.0, 1.0 - 2.0 * s)
+            ahead = min(s + lead, 1.0)
+            pos[2] = floor + self.clearance * _profile(self.shape_z, ahead)
         else:  # the floor is late: keep descending
             down = 0.5 * self.clearance * dt / self.late_s
             pos[2] = max(pos[2] - down, floor - 0.5 * self.clearance)
