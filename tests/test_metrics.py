@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -40,3 +41,47 @@ def test_no_torque_recorded_means_no_saturation_figure():
     m = walk_metrics(_rollout(), 0.5)
     assert m.torque_saturation is None and m.saturated_joint is None
     assert m.forward_distance_m == 0.5 and m.to_dict()["torque_saturation"] is None
+
+
+def _stepping(period: float, scuff_at: float | None = None, seconds: float = 12.0) -> Rollout:
+    """A synthetic walk: each foot down for 60 % of ``period`` (alternating), the torso
+    moving at 0.2 m/s; optionally one toe touch ``scuff_at`` [s] into a swing."""
+    dt = 0.01
+    t = np.arange(0.0, seconds, dt) + dt
+    force = np.zeros((len(t), 2, 4))
+    for j, shift in enumerate((0.0, 0.5)):
+        phase = ((t / period) + shift) % 1.0
+        down = phase < 0.6
+        if scuff_at is not None:
+            swing = (phase - 0.6) * period
+            down |= np.abs(swing - scuff_at) < 0.015
+        force[down, j] = 20.0
+    pos = np.zeros((len(t), 3))
+    pos[:, 0] = 0.2 * t
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (len(t), 1))
+    n = 3
+    return Rollout(t=t, q_cmd=np.zeros((len(t), n)), q=np.zeros((len(t), n)),
+                   gyro=np.zeros((len(t), 3)), accel=np.zeros((len(t), 3)), foot_force=force,
+                   torso_pos=pos, torso_quat=quat, qpos=np.zeros((len(t), 7)), fell=False,
+                   fall_time=None, control_dt=dt)  # fmt: skip
+
+
+@given(period=st.floats(0.8, 1.6))
+@settings(max_examples=15, deadline=None)
+def test_gait_timing_reads_cadence_and_stride_from_the_soles(period):
+    from imitwalk.sim.metrics import gait_timing
+
+    g = gait_timing(_stepping(period), weight_n=80.0, after_s=1.0, lifted_s=0.15)
+    assert g.cadence_spm == pytest.approx(120.0 / period, rel=0.03)
+    assert g.cycle_s == pytest.approx(period, rel=0.03)
+    assert g.stride_m == pytest.approx(0.2 * period, rel=0.05)
+    assert g.scuffs == 0
+
+
+def test_a_toe_touch_mid_swing_is_a_scuff_not_a_step():
+    from imitwalk.sim.metrics import gait_timing
+
+    clean = gait_timing(_stepping(1.2), weight_n=80.0, after_s=1.0, lifted_s=0.2)
+    scuffed = gait_timing(_stepping(1.2, scuff_at=0.12), weight_n=80.0, after_s=1.0, lifted_s=0.2)
+    assert scuffed.steps == clean.steps and scuffed.cadence_spm == pytest.approx(clean.cadence_spm)
+    assert scuffed.scuffs > 0 and clean.scuffs == 0
