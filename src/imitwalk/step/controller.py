@@ -103,9 +103,6 @@ class SteppingController:
         self.half = np.array([geom.foot_length, geom.foot_width]) / 2
         self.pelvis_z = style.pelvis_height - gains.crouch * geom.leg  # [m] over the soles
         self.omega = omega_of(self.joints.walking_com_height(self.pelvis_z, style.step_width))
-        legs = np.concatenate(list(self.joints.ik.legs.values()))
-        # the leg servos' time constant kv / kp [s]: how late a position servo follows
-        self._lag = float(np.median(self.joints.ik.kv[legs] / robot.kp[legs]))
         self.nominal = NominalWalk(style, gains, self.omega, self.pelvis_z)
         self.log = log
         self.ticks: list[TickLog] = []
@@ -122,7 +119,7 @@ class SteppingController:
         self.ds_time = (SETTLE + SHIFT) * st.step_time
         self.trail = FootPose(e.swing.pos.copy(), e.swing.yaw)  # the left foot, down
         self.swing = SwingFoot(st.swing_x, st.swing_z, st.clearance, LATE * st.step_time,
-                               g.swing_fix, 0.1 * st.geometry.leg, self._lag)  # fmt: skip
+                               g.swing_fix, 0.1 * st.geometry.leg)  # fmt: skip
         self.landing, self.land_yaw = np.array([0.0, st.step_width]), 0.0
         self.ss = st.single_support
         self.c_ref, self.v_ref = e.com[:2].copy(), np.zeros(2)

@@ -233,4 +233,7 @@ def learn_step(
         kept = finalists[best]
         fell = f"{final[best]['falls']}/{cfg.final_robots}"
         say(f"learn: kept {best} ({fell} fell on the final robots)")
+        if 2 * final[best]["falls"] > cfg.final_robots:
+            say("learn: warning: the stepping gait fell on most final robots; for this robot "
+                "or clip try `--variant extended` (the per-tick learner)")  # fmt: skip
     return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)

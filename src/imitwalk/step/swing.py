@@ -33,16 +33,13 @@ class SwingFoot:
         shape_x, shape_z: ``(P,)`` the style's forward progress and lift profiles;
         clearance: the peak lift [m]; late_s: how long a late floor is waited for [s];
         rate: how fast the sole's measured lag is integrated away [1/s]; limit: that
-        correction's bound per axis [m]; lead_s: the lift is commanded this far ahead of
-        its time as the foot leaves the floor [s] (the servos' lag, so that the toe
-        clears the floor on time), the lead fading out by mid-swing.
+        correction's bound per axis [m].
     """
 
     def __init__(self, shape_x, shape_z, clearance: float, late_s: float, rate: float,
-                 limit: float, lead_s: float = 0.0):  # fmt: skip
+                 limit: float):  # fmt: skip
         self.shape_x, self.shape_z = np.asarray(shape_x), np.asarray(shape_z)
         self.clearance, self.late_s, self.rate, self.limit = clearance, late_s, rate, limit
-        self.lead_s = lead_s
         self.lift_off(FootPose(np.zeros(3), 0.0))
 
     def lift_off(self, pose: FootPose) -> None:
@@ -68,11 +65,7 @@ class SwingFoot:
         # the floor under the foot: the lift-off spot's at first, the landing's at the end
         floor = x1 * float(slope[0] * landing[0] + slope[1] * landing[1])
         if s < 1.0:
-            # the lift ahead of its time while it rises, the lead fading out by mid-swing
-            # so that the descent, and so the touchdown, keep their time
-            lead = self.lead_s / max(duration, 1e-3) * max(0.0, 1.0 - 2.0 * s)
-            ahead = min(s + lead, 1.0)
-            pos[2] = floor + self.clearance * _profile(self.shape_z, ahead)
+            pos[2] = floor + self.clearance * _profile(self.shape_z, s)
         else:  # the floor is late: keep descending
             down = 0.5 * self.clearance * dt / self.late_s
             pos[2] = max(pos[2] - down, floor - 0.5 * self.clearance)
