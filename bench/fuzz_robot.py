@@ -3,8 +3,9 @@
 Loads each mutated pair as a user's robot (:func:`imitwalk.robots.load_robot`) in a
 worker process with a time limit per case, and prints one JSON object: per input (the
 joint map, the MJCF) how many cases gave a clean project error, were accepted with finite
-arrays, raised another exception, were accepted with a NaN or infinity, or hung; and the
-first failing cases. The mutations are in ``tests/robot_fuzz.py``.
+arrays within the plausibility bounds (:mod:`imitwalk.robots.plausible`), raised another
+exception, were accepted with a NaN or infinity, were accepted outside those bounds, or
+hung; and the first failing cases. The mutations are in ``tests/robot_fuzz.py``.
 
 Usage: ``python bench/fuzz_robot.py [--cases 4000] [--seed 1] [--timeout 20]``
 """

@@ -1,13 +1,18 @@
-"""Seeded mutations of hoap2's joint map and MJCF, loaded as a user's robot (issue 34).
+"""Seeded mutations of hoap2's joint map and MJCF, loaded as a user's robot (issues 34, 60).
 
 Each case is hoap2's two files with one of them mutated the way a hostile or careless
 user would: truncated, a byte flipped, a line deleted or doubled, a byte that is not
 UTF-8, a number made NaN, infinite, huge, negative or zero, a vector of the wrong
-length, a field of the wrong type, a key renamed, deep nesting. A case passes if loading
-it raises an :class:`~imitwalk.errors.ImitwalkError` or gives a :class:`Robot` whose
-arrays are finite (a torque limit may be ``inf``: no limit) and whose ``robot info`` is
-valid JSON. Cases run in a worker process with a time limit, so a hang is counted, not
-waited for. Used by ``tests/test_fuzz_robot.py`` and ``bench/fuzz_robot.py``.
+length, a field of the wrong type, a key renamed, deep nesting; and, in two of five
+MJCF cases, one number of a physical attribute (a mass, size, position, timestep, joint
+range or servo gain) set to a value no humanoid has. A case passes if loading it raises
+an :class:`~imitwalk.errors.ImitwalkError` in one line that names the file, or gives a
+:class:`Robot` whose arrays are finite (a torque limit may be ``inf``: no limit), whose
+mass, height, timestep, joint ranges and servo gains are within the bounds of
+:mod:`imitwalk.robots.plausible` (``accepted_implausible`` otherwise), and whose
+``robot info`` is valid JSON. Cases run in a worker process with a time limit, so a
+hang is counted, not waited for. Used by ``tests/test_fuzz_robot.py`` and
+``bench/fuzz_robot.py``.
 """
 
 from __future__ import annotations
@@ -23,7 +28,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 HOAP2 = Path(__file__).resolve().parents[1] / "src" / "imitwalk" / "robots" / "hoap2"
-OUTCOMES = ("project_error", "accepted", "other_exception", "accepted_nonfinite", "hang")
+OUTCOMES = (
+    "project_error",
+    "accepted",
+    "other_exception",
+    "accepted_nonfinite",
+    "accepted_implausible",
+    "hang",
+)
 _VALUES = [
     None,
     True,
@@ -108,6 +120,26 @@ def _text_mutation(rng: random.Random, data: bytes) -> tuple[str, bytes]:
     ).encode()
 
 
+#: MJCF attributes with a physical meaning, and values no humanoid has (NaN among them).
+_PHYSICAL = re.compile(
+    r'\b(mass|size|pos|timestep|range|kp|diaginertia|fromto|ctrlrange|forcerange)="([^"]*)"'
+)
+_WILD = ["nan", "inf", "1e308", "1e30", "-1e30", "0", "1e-30", "-1", "1e5", "300"]
+
+
+def _physical_mutation(rng: random.Random, data: bytes) -> tuple[str, bytes]:
+    """One number of a physical attribute (a mass, size, position, timestep, range, gain)
+    set to a value no humanoid has."""
+    text = data.decode()
+    m = rng.choice(list(_PHYSICAL.finditer(text)))
+    nums = m.group(2).split()
+    i, new = rng.randrange(len(nums)), rng.choice(_WILD)
+    nums[i] = new
+    how = f"{m.group(1)}={m.group(2)!r} at {m.start()}: number {i} -> {new!r}"
+    value = f'{m.group(1)}="{" ".join(nums)}"'
+    return how, (text[: m.start()] + value + text[m.end() :]).encode()
+
+
 def _map_mutation(rng: random.Random, jmap: dict, raw: bytes) -> tuple[str, bytes]:
     if rng.random() < 0.3:
         return _text_mutation(rng, raw)
@@ -146,12 +178,37 @@ def cases(n: int, seed: int = 0):
             how, data = _map_mutation(rng, jm, raw)
             yield Case("map", how, data, xml)
         else:
-            how, data = _text_mutation(rng, xml)
+            mutate = _physical_mutation if rng.random() < 0.4 else _text_mutation
+            how, data = mutate(rng, xml)
             yield Case("mjcf", how, raw, data)
 
 
+def _implausible(robot) -> str | None:
+    """Which bound of :mod:`imitwalk.robots.plausible` an accepted robot is outside
+    (``None``: none), checked here on the robot record and its model."""
+    from imitwalk.robots import plausible as p
+
+    model = robot.compile()
+    (m0, m1), (h0, h1), (t0, t1) = p.TOTAL_MASS_KG, p.HEIGHT_M, p.TIMESTEP_S
+    (r0, r1), (k0, k1) = p.JOINT_RANGE_RAD, p.SERVO_KP
+    checks = {
+        "total_mass": m0 <= robot.total_mass <= m1,
+        "height": h0 <= robot.height <= h1,
+        "torso_height": 0 < robot.torso_height <= robot.height,
+        "body_mass": model.body_mass.max() <= p.BODY_MASS_KG,
+        "body_inertia": model.body_inertia.max() <= p.BODY_INERTIA_KGM2,
+        "timestep": t0 <= model.opt.timestep <= t1,
+        "limits": bool(((r0 <= robot.limits) & (robot.limits <= r1)).all())
+        and bool((robot.limits[:, 0] < robot.limits[:, 1]).all()),
+        "kp": bool(((k0 < robot.kp) & (robot.kp <= k1)).all()),
+    }
+    bad = [name for name, ok in checks.items() if not ok]
+    return f"implausible {', '.join(bad)}" if bad else None
+
+
 def _finite_robot(robot) -> str | None:
-    """What is wrong with an accepted robot (``None``: nothing)."""
+    """What is wrong with an accepted robot (``None``: nothing): a non-finite array or
+    number, or a value outside the plausibility bounds."""
     import numpy as np
 
     from imitwalk.cli.progress import _finite
@@ -164,6 +221,8 @@ def _finite_robot(robot) -> str | None:
     for name in ("total_mass", "torso_height", "height"):
         if not np.isfinite(getattr(robot, name)):
             return f"{name} not finite"
+    if (why := _implausible(robot)) is not None:
+        return why
     info = {"limits": robot.limits.tolist(), "torque": robot.torque_limit.tolist()}
     json.dumps(_finite(info), allow_nan=False)
     return None
@@ -186,14 +245,20 @@ def run_case(case: Case, folder: Path) -> tuple[str, str]:
         robot = robots.load_robot(folder / "bot.xml", folder / "bot.json")
     except ImitwalkError as exc:
         msg = str(exc)
-        return ("project_error", msg) if "\n" not in msg else ("other_exception", "two lines")
+        if "\n" in msg:
+            return "other_exception", "two lines"
+        if "bot.xml" not in msg and "bot.json" not in msg:
+            return "other_exception", f"names neither file: {msg}"[:300]
+        return "project_error", msg
     except BaseException as exc:  # what the fuzz is for: anything else is a defect
         if isinstance(exc, KeyboardInterrupt):
             raise
         tb = traceback.format_exc().strip().splitlines()
         return "other_exception", f"{type(exc).__name__}: {exc} @ {tb[-3].strip()}"[:300]
     bad = _finite_robot(robot)
-    return ("accepted_nonfinite", bad) if bad else ("accepted", "")
+    if bad is None:
+        return "accepted", ""
+    return ("accepted_implausible" if bad.startswith("implausible") else "accepted_nonfinite"), bad
 
 
 def _serve(conn, folder: str) -> None:

@@ -113,7 +113,9 @@ def test_advance_moves_a_loop_row_as_the_plan_does(template, geom):
 
 
 def test_commands_out_of_range_are_one_line_errors():
-    with pytest.raises(ConfigError, match=r"turn_deg=90.*-30 <= turn_deg <= 30"):
+    with pytest.raises(
+        ConfigError, match=r"--turn 90 \(setting command\.turn_deg\): expected -30 <= --turn <= 30"
+    ):
         GaitCommand(turn_deg=90)
     with pytest.raises(ConfigError, match="forward"):
         GaitCommand(forward=-1)
@@ -220,7 +222,7 @@ def test_cli_retarget_turn_and_bad_commands(tmp_path, capsys):
     bad = tmp_path / "bad.npz"
     assert main(["retarget", "--out", str(bad), "--no-search", "--turn", "45"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].startswith("error: ") and "turn_deg=45" in err[-1] and not bad.exists()
+    assert err[-1].startswith("error: ") and "--turn 45" in err[-1] and not bad.exists()
     assert (
         main(["learn", "--reference", str(out), "--out", str(tmp_path / "r"), "--slope", "2"]) == 2
     )

@@ -1,5 +1,6 @@
 """The robot loader fuzzed: mutated hoap2 joint maps and MJCF give a one-line project
-error or a valid robot, never another exception, a NaN, or a hang (issue 34)."""
+error naming the file or a valid robot within the plausibility bounds, never another
+exception, a NaN, an implausible robot, or a hang (issues 34, 60)."""
 
 from __future__ import annotations
 

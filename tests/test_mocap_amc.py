@@ -97,5 +97,8 @@ def test_skeleton_must_be_given_unless_single_asf_beside(shared_mocap, tmp_path,
     amc.symlink_to(shared_mocap / AMC)
     for i in range(n_asf):
         (tmp_path / f"s{i}.asf").symlink_to(shared_mocap / ASF)
-    _one_line(lambda: load_motion(amc), rf"pass skeleton= the ASF file; {n_asf} .asf files")
+    _one_line(
+        lambda: load_motion(amc),
+        rf"name its ASF with --skeleton \(skeleton= in Python\); {n_asf} .asf files",
+    )
     assert load_motion(amc, skeleton=shared_mocap / ASF).n_frames == 2751

@@ -147,4 +147,4 @@ def test_absent_required_marker(trial, tmp_path):
 def test_not_a_c3d(tmp_path):
     path = tmp_path / "x.c3d"
     path.write_bytes(b"\0" * 600)
-    _one_line(lambda: read_c3d(path), "not a readable C3D file")
+    _one_line(lambda: read_c3d(path), "not a C3D file: byte 2 of its header is 0")

@@ -66,6 +66,10 @@ def test_no_straight_cycle_is_one_line_unless_a_turn_is_commanded(shared_mocap):
     assert "\n" not in msg and f"at most {MAX_TURN_DEG:g} deg" in msg and "--turn" in msg
     t = extract_template(m, allow_turn=True)
     assert t.cycles == ((24, 164), (164, 301))
+    turns = [abs(c.turn_deg) for c in t.meta["cycle_choice"].checks]
+    assert min(turns) > MAX_TURN_DEG  # so no kept cycle is called straight
+    report = t.meta["cycles_report"]
+    assert "(turning, allowed by --turn: turn <=" in report and "straight" not in report
 
 
 def test_an_unsteady_cycle_is_left_out(shared_mocap):

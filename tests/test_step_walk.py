@@ -107,6 +107,11 @@ def test_learn_and_evaluate_a_stepping_run_through_the_cli(tmp_path, capsys):
     assert main(argv) == 0
     ev = json.loads(capsys.readouterr().out)
     assert set(ev["controllers"]) == {"learned", "default"}
+    # a damaged checkpoint is refused on --resume in one line, before any walk
+    (out / "cma.pkl").write_bytes((out / "cma.pkl").read_bytes()[:40])
+    assert main(["learn", "--out", str(out), "--resume", *sets(TINY_STEP)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) >= 1 and err[-1].startswith("error: ") and "cma.pkl" in err[-1]
     # a stepping run refuses the joint-space learner's flags, in one line
     assert main(["learn", "--out", str(tmp_path / "x"), "--turn", "10"]) == 2
     assert "--turn" in capsys.readouterr().err
@@ -144,3 +149,17 @@ def test_a_broken_stepping_run_is_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("error: ") and "gains.json" in err[-1]
     assert not any("Traceback" in line for line in err)
+
+
+def test_a_stepping_run_names_the_robot_file_it_learned_on(gait, tmp_path):
+    """``evaluate RUN`` without ``--robot`` finds an imported robot by the file its
+    stepping gait records, not by the robot's name in ``config.json``."""
+    from dataclasses import replace
+
+    from imitwalk.cli.commands import _run_robot
+    from imitwalk.runs import RunDir
+
+    replace(gait, settings={"robot": "/x/op3.json", "joint_map": None}).save(
+        tmp_path / "style.json"
+    )
+    assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/x/op3.json", None)

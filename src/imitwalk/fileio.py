@@ -1,4 +1,5 @@
-"""Writing files atomically (pure Python): a reader never sees a half-written file."""
+"""Writing files (pure Python): atomically, so that a reader never sees a half-written
+file, and to paths checked before any work starts."""
 
 from __future__ import annotations
 
@@ -6,7 +7,9 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write"]
+from imitwalk.errors import ConfigError, ImitwalkError
+
+__all__ = ["atomic_write", "check_writable", "writable_folder"]
 
 
 def atomic_write(path: str | Path, write) -> Path:
@@ -24,4 +27,39 @@ def atomic_write(path: str | Path, write) -> Path:
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+    return path
+
+
+def writable_folder(folder: Path) -> bool:
+    """True if a file can be created in ``folder`` (tried: a probe file is made and
+    removed, so that read-only file systems and permissions are both found out)."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".imitwalk-probe.", dir=folder)
+    except OSError:
+        return False
+    os.close(fd)
+    os.unlink(probe)
+    return True
+
+
+def check_writable(
+    path: str | Path, flag: str = "--out", error: type[ImitwalkError] = ConfigError
+) -> Path:
+    """Refuse, before any work starts, a file path that cannot be written: a folder, a
+    path whose parent folder is missing or is a file, or a folder that cannot be
+    written in. ``flag`` names the path's command-line flag in the message.
+
+    Returns:
+        ``path`` as a :class:`Path`.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise error(f"{flag} {path} is a folder; give the name of a file to write")
+    parent = path.parent
+    if not parent.exists():
+        raise error(f"{flag} {path}: folder {parent} does not exist; create it first")
+    if not parent.is_dir():
+        raise error(f"{flag} {path}: {parent} is a file, not a folder")
+    if not writable_folder(parent):
+        raise error(f"{flag} {path}: cannot write in {parent}; choose another {flag}")
     return path

@@ -19,10 +19,18 @@ from typing import Any, cast
 
 import numpy as np
 
+from imitwalk import readback
 from imitwalk.errors import RunError
-from imitwalk.fileio import atomic_write
+from imitwalk.fileio import atomic_write, writable_folder
 
-__all__ = ["LearnSummary", "RunDir"]
+__all__ = ["RUN_FORMAT", "LearnSummary", "RunDir"]
+
+#: The format of a run folder's ``config.json`` and ``metrics.json`` that this imitwalk
+#: writes, and the newest it reads (:func:`~imitwalk.readback.check_format`; a file
+#: without a ``format`` is a run written before versions, read as format 1).
+RUN_FORMAT = 1
+#: The run files that carry a ``format``.
+_VERSIONED = ("config.json", "metrics.json")
 
 
 def _json_default(v):
@@ -39,6 +47,18 @@ _TICK_ONLY = ("trial_scale", "trial_falls", "feedback_gains", "trust", "referenc
 _FAITHFUL_ONLY = ("variant", "gait")
 _STEP_ONLY = ("gains", "final")
 _ONLY = {"tick": _TICK_ONLY, "faithful": _FAITHFUL_ONLY, "step": _STEP_ONLY}
+
+
+#: The types of the fields every learner writes to ``metrics.json``.
+_SUMMARY_TYPES = {
+    "learner": str,
+    "scale_reached": float,
+    "scales_passed": list,
+    "iterations": int,
+    "sim_seconds_used_for_learning": float,
+    "wall_seconds_for_learning": float,
+    "config": dict,
+}
 
 
 @dataclass(frozen=True)
@@ -97,6 +117,7 @@ class LearnSummary:
         missing = [k for k in required if not isinstance(d, dict) or k not in d]
         if missing:
             raise RunError(f"{where} lacks {', '.join(missing)}: not a finished imitwalk run")
+        readback.check_fields(d, _SUMMARY_TYPES, where, RunError)
         return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
 
 
@@ -106,18 +127,19 @@ class RunDir:
     def __init__(self, path: str | Path):
         self.path = Path(path)
 
-    def check_writable(self) -> None:
+    def check_writable(self, flag: str = "--out") -> None:
         """Refuse, before any work starts, a folder that cannot be one: a path that is a
-        file, or one whose nearest existing parent is not a writable folder."""
-        import os
-
+        file, one whose parent folder is missing, or one that cannot be written in.
+        ``flag`` names the folder's command-line argument in the message."""
         if self.path.exists() and not self.path.is_dir():
-            raise RunError(f"{self.path} is a file, not a run folder; choose another --out")
-        parent = self.path
-        while not parent.exists():
-            parent = parent.parent
-        if not parent.is_dir() or not os.access(parent, os.W_OK):
-            raise RunError(f"cannot write a run folder under {parent}; choose another --out")
+            raise RunError(f"{self.path} is a file, not a run folder; choose another {flag}")
+        folder = self.path if self.path.is_dir() else self.path.parent
+        if not folder.exists():
+            raise RunError(f"{flag} {self.path}: folder {folder} does not exist; create it first")
+        if not folder.is_dir():
+            raise RunError(f"{flag} {self.path}: {folder} is a file, not a folder")
+        if not writable_folder(folder):
+            raise RunError(f"{flag} {self.path}: cannot write in {folder}; choose another {flag}")
 
     def file(self, name: str) -> Path:
         """Path of a file in the run folder."""
@@ -128,7 +150,10 @@ class RunDir:
         return self.file(name).is_file()
 
     def write_json(self, name: str, obj) -> Path:
-        """Write ``obj`` as JSON atomically."""
+        """Write ``obj`` as JSON atomically (``config.json`` and ``metrics.json`` with
+        their ``format``, :data:`RUN_FORMAT`)."""
+        if name in _VERSIONED and isinstance(obj, dict):
+            obj = {readback.FORMAT_KEY: RUN_FORMAT, **obj}
         text = json.dumps(obj, indent=2, default=_json_default)
         return atomic_write(self.file(name), lambda tmp: tmp.write_text(text + "\n"))
 
@@ -139,15 +164,19 @@ class RunDir:
             self.read_json("metrics.json"), str(self.file("metrics.json"))
         )
 
-    def read_json(self, name: str):
-        """Read a JSON file; :class:`RunError` if missing or broken."""
+    def read_json(self, name: str, required: tuple[str, ...] = ()) -> dict:
+        """Read a JSON object holding the ``required`` keys; a one-line :class:`RunError`
+        if it is missing, broken or not such an object, or (``config.json``,
+        ``metrics.json``) of a newer format than :data:`RUN_FORMAT`; their ``format`` is
+        checked and left out of the object returned."""
         p = self.file(name)
-        if not p.is_file():
+        if not p.exists():
             raise RunError(f"{p} not found: is {self.path} a finished imitwalk run?")
-        try:
-            return json.loads(p.read_text())
-        except json.JSONDecodeError as exc:
-            raise RunError(f"{p} is not valid JSON: {exc.msg}") from None
+        doc = readback.read_json(p, f"the {name} of an imitwalk run", RunError, required)
+        if name in _VERSIONED:  # checked, then left out: what it holds is what was written
+            readback.check_format(doc, RUN_FORMAT, str(p), RunError)
+            doc.pop(readback.FORMAT_KEY, None)
+        return doc
 
     def write_log(self, entries: list[dict]) -> Path:
         """Rewrite the per-iteration log (one JSON object per line) atomically."""
@@ -157,9 +186,16 @@ class RunDir:
     def read_log(self) -> list[dict]:
         """The per-iteration log (empty if none)."""
         p = self.file("log.jsonl")
-        if not p.is_file():
+        if not p.exists():
             return []
-        return [json.loads(line) for line in p.read_text().splitlines() if line.strip()]
+        try:
+            lines = p.read_text(encoding="utf-8").splitlines()
+            entries = [json.loads(line) for line in lines if line.strip()]
+        except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
+            raise RunError(f"{p} is not a learning log (one JSON object a line): {exc}") from None
+        if not all(isinstance(e, dict) for e in entries):
+            raise RunError(f"{p} is not a learning log: a line is not a JSON object")
+        return entries
 
     def write_arrays(self, name: str, arrays: dict[str, np.ndarray]) -> Path:
         """Write a dict of arrays as compressed ``.npz`` atomically."""
@@ -172,11 +208,7 @@ class RunDir:
 
     def read_arrays(self, name: str) -> dict[str, np.ndarray]:
         """Read an ``.npz`` written by :meth:`write_arrays`."""
-        p = self.file(name)
-        if not p.is_file():
-            raise RunError(f"{p} not found")
-        with np.load(p, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
+        return readback.read_npz(self.file(name), f"the {name} of an imitwalk run", RunError)
 
     def start(self, config_json: dict, reference, resume: bool, settings=None):
         """Open a learning run: a fresh folder (``config.json`` and ``reference.npz``
@@ -193,7 +225,7 @@ class RunDir:
         if resume:
             if not self.exists("checkpoint.json"):
                 raise RunError(f"nothing to resume in {self.path}: no checkpoint.json")
-            saved = self.read_json("config.json")["learn"]
+            saved = self.read_json("config.json", ("learn",))["learn"]
             if (settings(saved) if settings else saved) != config_json["learn"]:
                 raise RunError(
                     f"{self.path} was started with other settings; resume with the same ones"

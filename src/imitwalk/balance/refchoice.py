@@ -84,7 +84,7 @@ def law_walker(run_dir) -> LawWalker:
     """The :class:`LawWalker` of the finished per-tick run in ``run_dir``."""
     rd = RunDir(run_dir)
     settings = rd.read_summary().reference_settings or {}
-    learn = rd.read_json("config.json")["learn"]
+    learn = rd.read_json("config.json", ("learn",))["learn"]
     return LawWalker(
         load_laws(run_dir)["feedback"][0],
         float(settings.get("feedforward", 0.0)),

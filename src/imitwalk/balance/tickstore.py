@@ -116,7 +116,7 @@ def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
     and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""
     rd = RunDir(run_dir)
     metrics = rd.read_summary()
-    cfg = from_dict(TickLearnConfig, rd.read_json("config.json")["learn"])
+    cfg = from_dict(TickLearnConfig, rd.read_json("config.json", ("learn",))["learn"])
     if metrics.feedback_gains is None:
         raise RunError(f"{rd.file('metrics.json')} has no feedback_gains: not a per-tick run")
     profiles = rd.read_json("checkpoint.json").get("profiles", {})  # none before 2026-12-04

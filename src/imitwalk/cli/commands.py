@@ -16,6 +16,8 @@ __all__ = [
     "playback",
     "retarget",
     "robot_from",
+    "robot_label",
+    "standing_robot",
 ]
 
 
@@ -24,6 +26,28 @@ def robot_from(args: argparse.Namespace):
     from imitwalk.robots import load_robot
 
     return load_robot(args.robot, getattr(args, "joint_map", None))
+
+
+def robot_label(args: argparse.Namespace) -> str:
+    """The robot as the command line gave it: ``--robot`` (or the positional robot), and
+    ``--joint-map`` if given."""
+    jm = getattr(args, "joint_map", None)
+    return str(args.robot) + (f" (joint map {jm})" if jm else "")
+
+
+def standing_robot(args: argparse.Namespace):
+    """:func:`robot_from`, refused at once if it cannot stand: the stand check of
+    :mod:`imitwalk.sim.standing` (a 2 s hold of the nominal robot, well under a second of
+    computing), so that ``learn`` never spends minutes on a robot that falls standing still.
+
+    Raises:
+        RobotError: one line with the tilt or height measured and the joint-map keys to change.
+    """
+    from imitwalk.sim.standing import require_standing
+
+    robot = robot_from(args)
+    require_standing(robot, robot_label(args))
+    return robot
 
 
 def _motion(args: argparse.Namespace):
@@ -41,9 +65,11 @@ def _motion(args: argparse.Namespace):
 
 def retarget(args: argparse.Namespace) -> int:
     from imitwalk.config import apply_overrides
+    from imitwalk.fileio import check_writable
     from imitwalk.retarget import RetargetConfig
     from imitwalk.retarget import retarget as run
 
+    check_writable(args.out)
     robot = robot_from(args)
     cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
     cfg = _with_command(apply_overrides(cfg, args.set), args)
@@ -136,7 +162,7 @@ def learn(args: argparse.Namespace) -> int:
     from imitwalk.retarget import retarget as do_retarget
     from imitwalk.runs import RunDir
 
-    robot = robot_from(args)
+    robot = standing_robot(args)  # every variant, before any work
     args.variant = _variant(args)
     if args.variant == "step":
         return _learn_step(args, robot)
@@ -278,6 +304,7 @@ def evaluate(args: argparse.Namespace) -> int:
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
+    rd.check_writable("RUN_DIR")  # the verdict is written there
     if args.robot is None:
         args.robot, args.joint_map = _run_robot(rd, cfg)
     robot = robot_from(args)
@@ -315,13 +342,17 @@ def evaluate(args: argparse.Namespace) -> int:
 
 
 def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
-    """The robot a run learned on and its joint map: the file its reference records (a
-    built-in name, or the joint map's path), else the name in its ``config.json``."""
+    """The robot a run learned on and its joint map: the file its reference or its
+    stepping gait records (a built-in name, or the joint map's path), else the name in
+    its ``config.json``."""
     from imitwalk.retarget import Reference
+    from imitwalk.step.gait import StepGait
 
-    settings = (
-        Reference.load(rd.file("reference.npz")).settings if rd.exists("reference.npz") else {}
-    )
+    settings: dict = {}
+    if rd.exists("reference.npz"):
+        settings = Reference.load(rd.file("reference.npz")).settings
+    elif rd.exists("style.json"):
+        settings = StepGait.load(rd.file("style.json")).settings
     name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
     return name or "hoap2", settings.get("joint_map")
 
@@ -355,6 +386,7 @@ def report(args: argparse.Namespace) -> int:
 
     rd = RunDir(args.run_dir)
     rd.read_summary()  # a clear error if this is not a finished run
+    rd.check_writable("RUN_DIR")  # report.html is written there
     robot = None
     if args.robot:
         robot = robot_from(args)

@@ -83,7 +83,10 @@ def _settings(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
+    from imitwalk import __version__
+
     p = argparse.ArgumentParser(prog="imitwalk", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"imitwalk {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     robot = sub.add_parser("robot", help="inspect and test a robot model")
@@ -92,7 +95,11 @@ def build_parser() -> argparse.ArgumentParser:
     _robot_args(info)
     info.add_argument("--json", action="store_true", help="print JSON")
     info.set_defaults(func=robot_commands.robot_info)
-    stand = rsub.add_parser("stand", help="hold the standing keyframe; report tilt and forces")
+    stand = rsub.add_parser(
+        "stand",
+        help="hold the standing posture; report tilt and forces, exit 2 if it does not stand "
+        "(tilt over 20 deg, sinking, still tipping: the check learn makes)",
+    )
     _robot_args(stand)
     stand.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (10)")
     stand.add_argument("--json", action="store_true", help="print JSON")

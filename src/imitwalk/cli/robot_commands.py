@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from imitwalk.cli.commands import robot_from
+from imitwalk.cli.commands import robot_from, robot_label
 from imitwalk.cli.progress import emit, progress
 
 __all__ = ["robot_import", "robot_info", "robot_stand"]
@@ -54,31 +54,33 @@ def robot_info(args: argparse.Namespace) -> int:
 
 
 def robot_stand(args: argparse.Namespace) -> int:
-    from imitwalk.errors import RobotError
-    from imitwalk.sim.standing import stand_test
+    """Hold the standing posture ``--seconds``; exit 2 with the stand check's one line if
+    the robot does not stand (:mod:`imitwalk.sim.standing`)."""
+    from imitwalk.sim.standing import require_standing
 
-    robot = robot_from(args)
-    res = stand_test(robot, seconds=args.seconds)
-    if res.fell:
-        raise RobotError(res.refusal(robot.name))
+    res = require_standing(robot_from(args), robot_label(args), seconds=args.seconds)
     emit(res.to_dict(), args.json, finite=True)
     return 0
 
 
 def robot_import(args: argparse.Namespace) -> int:
+    """Draft and write the joint map of an MJCF robot. A robot that does not stand in the
+    drafted posture still gets its joint map written (exit 0): that file is where the user
+    makes it stand. Its summary then says ``"stands": false`` and a ``warning:`` line says
+    what to change; ``robot stand`` and ``learn`` refuse it until it stands."""
     from imitwalk.errors import RobotError
-    from imitwalk.fileio import atomic_write
+    from imitwalk.fileio import atomic_write, check_writable
     from imitwalk.robots.draft import draft_joint_map
 
-    out, mjcf = Path(args.out), Path(args.mjcf)
-    if out.is_dir():
-        raise RobotError(f"--out {out} is a folder; give the joint map's file name")
+    out, mjcf = check_writable(args.out, "--out", RobotError), Path(args.mjcf)
     if out.exists() and mjcf.exists() and out.resolve() == mjcf.resolve():
         raise RobotError(f"--out {out} is the MJCF file itself; imitwalk never edits it")
     draft = draft_joint_map(mjcf, out)
     for line in draft.lines:
         progress(f"  {line}")
     atomic_write(out, lambda tmp: tmp.write_text(json.dumps(draft.jmap, indent=2) + "\n"))
+    if (advice := draft.advice(str(out))) is not None:
+        progress(f"warning: {advice}; {out} is written for you to edit")
     r = draft.robot
     summary = {
         "out": str(out),
@@ -87,6 +89,7 @@ def robot_import(args: argparse.Namespace) -> int:
         "roles": list(r.joint_names),
         "total_mass_kg": r.total_mass,
         "standing_height_m": r.height,
+        "stands": draft.stand.stands,
         "stand": draft.stand.to_dict(),
     }
     emit(summary, args.json, finite=True)

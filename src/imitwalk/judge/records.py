@@ -69,7 +69,10 @@ class ControllerVerdict:
     Attributes:
         robots, survived, falls: counts; survival: survived ÷ robots, with its 95 % Wilson
         interval ``survival_ci95``; distance_m [m], speed_mps [m/s], abs_yaw_deg [deg]:
-        means over the robots (``None`` for none); progress_ratio_min: the slowest robot's;
+        means over the robots (``None`` for none); progress_ratio_min: the slowest robot's
+        progress ratio, its distance over the one commanded over the whole judged time
+        (1: the commanded walk; a robot that falls at once: about 0, at most its
+        standing height over that distance; :func:`~imitwalk.sim.metrics.walk_metrics`);
         falls_by_furthest_factor: falls counted under the factor each robot drew furthest
         from nominal; per_seed: the robots' rows, in seed order;
         falls_saved_by_factor: with the falls explained, factor → the falls its removal

@@ -105,11 +105,13 @@ def run_controller(job: JudgeJob) -> RobotWalk:
     policy = lr.policy(job.controller, job.robot, scale, job.seconds)
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
     ro = run(plant, policy, round(job.seconds / ref.dt))
+    # progress over the whole judged walk, so that an early fall scores the share of it
+    # made (about 0), not its fall over the few millimetres commanded before it
     m = walk_metrics(
         ro,
-        ref.expected_distance(scale, ro.seconds),
+        ref.expected_distance(scale, job.seconds),
         ref.trajectory(scale, job.seconds),
-        ref.track(scale, ro.seconds),
+        ref.track(scale, job.seconds),
     )
     return RobotWalk(job.seed, job.furthest, m)
 

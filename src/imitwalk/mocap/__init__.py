@@ -56,7 +56,8 @@ def _skeleton_for(amc: Path, skeleton: str | Path | None) -> Path:
     if len(found) != 1:
         which = ", ".join(p.name for p in found) if found else "none"
         raise MocapError(
-            f"{amc}: pass skeleton= the ASF file; {len(found)} .asf files beside it ({which})"
+            f"{amc}: name its ASF with --skeleton (skeleton= in Python); {len(found)} .asf "
+            f"files beside it ({which})"
         )
     return found[0]
 
@@ -94,14 +95,18 @@ def load_motion(
             f"unknown mocap file extension {p.suffix or '(none)'!r} of {p.name}; "
             f"valid: {', '.join(EXTENSIONS)}"
         )
+    if p.is_dir():
+        raise MocapError(f"{p} is a folder, not a mocap file")
     if not p.is_file():
         raise MocapError(f"mocap file not found: {p}")
     if units is not None and kind != "bvh":
-        raise MocapError(f"units= applies to BVH files only; {p.name} is {kind}")
+        raise MocapError(f"--units applies to BVH files only; {p.name} is {kind}")
     if joint_names is not None and kind != "bvh":
-        raise MocapError(f"joint_names= applies to BVH files only; {p.name} is {kind}")
+        raise MocapError(f"--joint-names applies to BVH files only; {p.name} is {kind}")
     if up is not None and kind == "deepmimic":
-        raise MocapError(f"up= does not apply to DeepMimic files (y-up by definition): {p.name}")
+        raise MocapError(f"--up does not apply to DeepMimic files (y-up by definition): {p.name}")
+    if skeleton is not None and kind != "amc":
+        raise MocapError(f"--skeleton applies to AMC files only; {p.name} is {kind}")
     if kind == "bvh":
         return read_bvh(p, units=units, up=up, joint_names=joint_names)
     if kind == "amc":

@@ -50,6 +50,8 @@ UP_AXES: tuple[str, ...] = ("x", "y", "z", "-x", "-y", "-z")
 def read_lines(path: str | Path) -> list[str]:
     """Read a text file as lines (any line ending); a missing/unreadable file -> MocapError."""
     p = Path(path)
+    if p.is_dir():
+        raise MocapError(f"{p} is a folder, not a mocap file")
     if not p.is_file():
         raise MocapError(f"mocap file not found: {p}")
     try:

@@ -5,7 +5,9 @@
   the listed order, first listed applied first); its world rotation is
   ``G = G_parent @ C @ M @ C^-1`` (i.e. ``L = C^-1 M C`` in the spec's row-vector form),
   and it ends at ``start + length * G @ direction``.
-* AMC: ``:FULLY-SPECIFIED``, ``:DEGREES`` (or ``:RADIANS``), 120 Hz unless told.
+* AMC: ``:FULLY-SPECIFIED``, ``:DEGREES`` (or ``:RADIANS``), 120 Hz unless told; another
+  header line is refused, and so is a frame number that does not follow the one
+  before (a frame block repeated or out of order).
 * The up axis is told by the animated skeleton (head above the feet,
   :func:`~imitwalk.mocap.orient.decide_up`; CMU's ASF axes are y-up) unless ``up=``
   is given, and mapped to z up (:data:`~imitwalk.mocap._common.UP_TO_Z_UP`).
@@ -47,6 +49,10 @@ for _s in "lr":
     )
 
 
+#: The header lines of an AMC file (the Acclaim format's only ones).
+HEADERS = (":FULLY-SPECIFIED", ":DEGREES", ":RADIANS")
+
+
 class _AmcValues(NamedTuple):
     """An AMC's frame count ``T``, bone -> ``(T, n_dof)`` values (AMC angle unit), bone ->
     ``(T,)`` line numbers, and the AMC angle scale to degrees."""
@@ -62,15 +68,27 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> _AmcValues:
     rows: dict[str, list[list[float]]] = {}
     at: dict[str, list[int]] = {}
     counts: list[int] = []
+    frame = None
     angle_scale = 1.0
     for i, ln in enumerate(lines):
         tok = ln.split()
         if not tok or tok[0].startswith("#"):
             continue
         if tok[0].startswith(":"):
+            if tok[0].upper() not in HEADERS:
+                raise MocapError(
+                    f"{src}: line {i + 1}: unknown AMC header {tok[0]!r}; "
+                    f"valid: {', '.join(HEADERS)}"
+                )
             angle_scale = float(np.degrees(1.0)) if tok[0].upper() == ":RADIANS" else angle_scale
             continue
         if len(tok) == 1 and tok[0].isdigit():
+            if frame is not None and int(tok[0]) <= frame:
+                raise MocapError(
+                    f"{src}: line {i + 1}: frame {int(tok[0])} comes after frame {frame} "
+                    "(a frame block repeated or out of order)"
+                )
+            frame = int(tok[0])
             counts.append(0)
             continue
         name = tok[0]

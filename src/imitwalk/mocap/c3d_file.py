@@ -121,10 +121,47 @@ class _Raw(NamedTuple):
     units: str
 
 
+#: The C3D header's size, and the size of a parameter or data block [bytes].
+_BLOCK = 512
+#: A parameter section's processor types (byte 4 of its header).
+_PROCESSORS = {84: "Intel", 85: "DEC", 86: "MIPS"}
+
+
+def why_unreadable(p: Path) -> str:
+    """What is wrong with the header or the parameter section of a file the ``c3d``
+    package could not open, from its bytes (in words, without the package's text)."""
+    size = p.stat().st_size
+    with p.open("rb") as fh:
+        head = fh.read(_BLOCK)
+        if size < _BLOCK:
+            return f"truncated header: the file is {size} bytes, a C3D header is {_BLOCK}"
+        if head[1] != 0x50:
+            return f"not a C3D file: byte 2 of its header is {head[1]}, not the C3D mark 80"
+        start = (head[0] - 1) * _BLOCK
+        fh.seek(max(start, 0))
+        params = fh.read(4)
+    if start < _BLOCK or len(params) < 4:
+        return f"truncated parameter section: it should begin at byte {start}; the file is {size}"
+    end = start + params[2] * _BLOCK
+    if size < end:
+        return (
+            f"truncated parameter section: its {params[2]} blocks end at byte {end}; "
+            f"the file is {size} bytes"
+        )
+    if params[3] not in _PROCESSORS:
+        return f"corrupt parameter section: processor type {params[3]}, expected " + ", ".join(
+            f"{k} ({v})" for k, v in _PROCESSORS.items()
+        )
+    return "corrupt parameter section: a group or parameter in it cannot be read"
+
+
 def _open(p: Path) -> _Raw:
     with p.open("rb") as handle, warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=UserWarning, module="c3d")
-        reader = c3d.Reader(handle)
+        try:
+            reader = c3d.Reader(handle)
+        except Exception:  # the c3d package raises bare ValueError/struct.error/...
+            raise MocapError(f"{p}: {why_unreadable(p)}") from None
         if reader.get("POINT") is None:
             raise MocapError(f"{p}: no POINT group (expected the marker data)")
         if reader.get("POINT:LABELS") is None:
@@ -137,7 +174,14 @@ def _open(p: Path) -> _Raw:
                     for s in np.atleast_1d(reader.get(f"POINT:{key}").string_array).ravel()
                 ]
         expected = int(reader.frame_count)
-        frames = [pts[:, :4].copy() for _, pts, _ in reader.read_frames(copy=True)]
+        frames: list[np.ndarray] = []
+        try:
+            frames.extend(pts[:, :4].copy() for _, pts, _ in reader.read_frames(copy=True))
+        except Exception:
+            raise MocapError(
+                f"{p}: corrupt or truncated data section: it cannot be read after "
+                f"{len(frames)} of {expected} frames"
+            ) from None
         units_p = reader.get("POINT:UNITS")
         units = str(units_p.string_value).strip().lower() if units_p else "mm"
         return _Raw(reader, tuple(labels), expected, frames, float(reader.point_rate), units)
@@ -152,8 +196,8 @@ def read_trial(path: str | Path) -> C3dTrial:
         reader, labels, expected, frames, rate, units = _open(p)
     except MocapError:
         raise
-    except Exception as exc:  # the c3d package raises bare ValueError/struct.error/...
-        raise MocapError(f"{p}: not a readable C3D file: {exc}".replace("\n", " ")) from None
+    except Exception:  # a parameter the package cannot read (labels, rate, units)
+        raise MocapError(f"{p}: {why_unreadable(p)}") from None
     if not frames:
         raise MocapError(f"{p}: C3D file has no frames")
     if len(frames) < expected:
@@ -183,6 +227,6 @@ def read_trial(path: str | Path) -> C3dTrial:
         first = int(reader.first_frame)
         events = _events(reader, fps, first, str(p))
         widths = _widths(reader, str(p))
-    except Exception as exc:
-        raise MocapError(f"{p}: not a readable C3D file: {exc}".replace("\n", " ")) from None
+    except Exception:  # a parameter the package cannot read
+        raise MocapError(f"{p}: {why_unreadable(p)}") from None
     return C3dTrial(xyz, labels, fps, units, first, events, widths)

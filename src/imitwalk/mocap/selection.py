@@ -78,9 +78,15 @@ def _span(checks: list[CycleCheck]) -> str:
     turns = [abs(c.turn_deg) for c in checks]
     periods = [c.period_s for c in checks]
     return (
-        f"straight: turn <= {max(turns):.1f} deg per cycle; steady: "
+        f"{_straight(max(turns))}: turn <= {max(turns):.1f} deg per cycle; steady: "
         f"{min(periods):.2f}-{max(periods):.2f} s"
     )
+
+
+def _straight(turn: float) -> str:
+    """How a kept cycle that turns ``turn`` [deg] is described: ``straight`` within
+    :data:`MAX_TURN_DEG`, else ``turning`` (kept because a turn was commanded)."""
+    return "straight" if abs(turn) <= MAX_TURN_DEG else "turning, allowed by --turn"
 
 
 def _yaw(fwd: np.ndarray) -> np.ndarray:
@@ -143,7 +149,7 @@ def choose_cycles(
         elif not steady:
             reason = f"lasts {period:.2f} s, the median is {median:.2f} s"
         else:
-            reason = f"straight: turn {turn:.1f} deg; steady: {period:.2f} s"
+            reason = f"{_straight(turn)}: turn {turn:.1f} deg; steady: {period:.2f} s"
         checks.append(CycleCheck(a, b, turn, period, ok and steady, reason))
     kept = tuple((c.start, c.end) for c in checks if c.used)
     if not kept:

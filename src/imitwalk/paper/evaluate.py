@@ -42,7 +42,7 @@ def load_gait(run_dir) -> LearnedGait:
 
     rd = RunDir(run_dir)
     metrics = rd.read_summary()
-    cfg = from_dict(LearnConfig, rd.read_json("config.json")["learn"])
+    cfg = from_dict(LearnConfig, rd.read_json("config.json", ("learn",))["learn"])
     data = unstack_episodes(rd.read_arrays("data.npz")) if rd.exists("data.npz") else []
     return LearnedGait(Reference.load(rd.file("reference.npz")), cfg, data, metrics)
 

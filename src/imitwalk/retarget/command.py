@@ -55,6 +55,19 @@ LIMITS = {
 }
 
 
+#: The command-line flag of each field (``imitwalk retarget`` and ``learn``), which
+#: messages name first; ``--set command.<field>=...`` sets the same value.
+FLAGS = {"turn_deg": "--turn", "side_m": "--side", "forward": "--forward", "slope_deg": "--slope"}
+
+
+def _out_of_range(name: str, value: float, lo: float, hi: float, note: str = "") -> ConfigError:
+    """The one-line error for a command field outside ``[lo, hi]``, by its flag."""
+    flag = FLAGS[name]
+    return ConfigError(
+        f"{flag} {value:g} (setting command.{name}): expected {lo:g} <= {flag} <= {hi:g}{note}"
+    )
+
+
 #: A command is built before the robot is known: its sidestep may be this many times
 #: :data:`LIMITS`' (a robot up to this many times hoap2's leg); :func:`check_side` then
 #: holds it to the robot's own.
@@ -71,10 +84,7 @@ def check_side(command: GaitCommand, leg: float) -> None:
 
     lo, hi = (leg_scaled(x, leg) for x in LIMITS["side_m"])
     if not lo <= command.side_m <= hi:
-        raise ConfigError(
-            f"command side_m={command.side_m}: expected {lo:g} <= side_m <= {hi:g} "
-            "(scaled with this robot's leg)"
-        )
+        raise _out_of_range("side_m", command.side_m, lo, hi, " (scaled with this robot's leg)")
 
 
 @dataclass(frozen=True)
@@ -108,7 +118,7 @@ class GaitCommand:
             if name == "side_m":  # scaled with the robot's leg: checked by check_side
                 lo, hi = lo * SIDE_SLACK, hi * SIDE_SLACK
             if not (np.isfinite(v) and lo <= v <= hi):
-                raise ConfigError(f"command {name}={v}: expected {lo:g} <= {name} <= {hi:g}")
+                raise _out_of_range(name, v, lo, hi)
 
     @property
     def straight(self) -> bool:

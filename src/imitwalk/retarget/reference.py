@@ -11,12 +11,15 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
+from imitwalk.readback import FORMAT_KEY
 from imitwalk.retarget.command import GaitCommand, advance
+from imitwalk.retarget.reffile import REFERENCE_FORMAT, read_reference_file
 from imitwalk.sim.types import SimOptions
 
 __all__ = ["PLAN_KEYS", "Reference", "plan_arrays"]
@@ -235,7 +238,8 @@ class Reference:
 
     # -- persistence ----------------------------------------------------------
     def save(self, path: str | Path) -> Path:
-        """Write ``path`` (``.npz``) atomically."""
+        """Write ``path`` (``.npz``) atomically, its metadata of format
+        :data:`~imitwalk.retarget.reffile.REFERENCE_FORMAT`."""
         arrays = {}
         meta = {}
         for f in fields(self):
@@ -247,6 +251,7 @@ class Reference:
             else:
                 meta[f.name] = v
         arrays["q"] = self.loops[-1]  # the joint trajectory at the largest scale, (N, n)
+        meta = {FORMAT_KEY: REFERENCE_FORMAT, **meta}
         arrays["meta_json"] = np.array(json.dumps(meta, default=_jsonable))
 
         def write(tmp: Path) -> None:
@@ -257,20 +262,12 @@ class Reference:
 
     @classmethod
     def load(cls, path: str | Path) -> Reference:
-        """Read a reference written by :meth:`save`."""
-        path = Path(path)
-        if not path.is_file():
-            raise RunError(f"reference file not found: {path}")
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                meta = json.loads(str(z["meta_json"]))
-                arrays = {k: z[k] for k in z.files if k not in ("meta_json", "q")}
-            plan = {k[5:]: arrays.pop(k) for k in list(arrays) if k.startswith("plan_")}
-        except (OSError, ValueError, KeyError) as exc:
-            raise RunError(f"{path} is not an imitwalk reference: {exc}") from None
-        meta["joint_names"] = tuple(meta["joint_names"])
+        """Read a reference written by :meth:`save` (a one-line :class:`RunError` naming
+        the file and what is wrong if it is not one)."""
+        meta, read = read_reference_file(path)
+        plan = {k[5:]: read.pop(k) for k in list(read) if k.startswith("plan_")}
         known = {f.name for f in fields(cls)}
-        arrays = {k: v for k, v in arrays.items() if k in known}
+        arrays: dict[str, Any] = {k: v for k, v in read.items() if k in known}
         return cls(**{k: v for k, v in meta.items() if k in known}, **arrays, plan=plan)
 
     def summary(self) -> dict:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+from collections.abc import Callable
 from pathlib import Path
 
 from imitwalk.errors import RobotError, unknown_name
@@ -23,6 +25,9 @@ _HERE = Path(__file__).parent
 #: Built-in robots: name -> joint map shipped with the package.
 BUILTIN: dict[str, Path] = {"hoap2": _HERE / "hoap2" / "hoap2.json"}
 
+#: A message that names a robot file (an MJCF or a joint map) already.
+_NAMES_A_FILE = re.compile(r"\.(xml|json)\b", re.IGNORECASE)
+
 _CACHE: dict[tuple[str, str | None], Robot] = {}
 
 
@@ -43,16 +48,16 @@ def load_robot(robot: str | Path, joint_map: str | Path | None = None) -> Robot:
     name = str(robot)
     if name in BUILTIN and joint_map is None:
         path = BUILTIN[name]
-        spec = Robot.from_map(_read(path), path.parent)
+        spec = _named(path, None, lambda: Robot.from_map(_read(path), path.parent))
     else:
         path = Path(name)
         if path.suffix.lower() == ".json" and joint_map is None:
-            spec = Robot.from_map(_read(path), path.parent)
+            spec = _named(path, None, lambda: Robot.from_map(_read(path), path.parent))
         elif path.suffix.lower() == ".xml":
             if joint_map is None:
                 raise RobotError(f"{path} needs a joint map (--joint-map FILE.json)")
             jm = Path(joint_map)
-            spec = Robot.from_map(_read(jm), jm.parent, mjcf=path)
+            spec = _named(jm, path, lambda: Robot.from_map(_read(jm), jm.parent, mjcf=path))
         elif not path.exists() and path.suffix == "":
             raise unknown_name("robot", name, BUILTIN)
         else:
@@ -61,6 +66,19 @@ def load_robot(robot: str | Path, joint_map: str | Path | None = None) -> Robot:
             )
     _CACHE[key] = spec
     return spec
+
+
+def _named(jmap: Path, mjcf: Path | None, load: Callable[[], Robot]) -> Robot:
+    """``load()``, its :class:`RobotError` naming the joint map (and the MJCF) if its
+    message names no file (an unknown joint, sensor or key found while matching them)."""
+    try:
+        return load()
+    except RobotError as exc:
+        msg = str(exc)
+        if _NAMES_A_FILE.search(msg):
+            raise
+        where = f"joint map {jmap}" + (f" (for {mjcf})" if mjcf is not None else "")
+        raise type(exc)(f"{where}: {msg}") from None
 
 
 def _read(path: Path):

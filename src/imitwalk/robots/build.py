@@ -96,8 +96,15 @@ def load_spec(mjcf: Path) -> mujoco.MjSpec:
     if not mjcf.is_file():
         raise RobotError(f"robot file not found: {mjcf}")
     check_text(mjcf)
+    path = mjcf.resolve()
     try:
-        return mujoco.MjSpec.from_file(str(mjcf.resolve()))
+        if path.suffix == ".xml":
+            return mujoco.MjSpec.from_file(str(path))
+        # MuJoCo picks its decoder by a lower-case suffix: read any other name (``.XML``)
+        # as text, its meshes and textures still relative to its folder
+        spec = mujoco.MjSpec.from_string(path.read_text(encoding="utf-8"))
+        spec.modelfiledir = str(path.parent) + "/"
+        return spec
     except (ValueError, mujoco.FatalError) as exc:
         raise RobotError(f"{mjcf} is not valid MJCF: {' '.join(str(exc).split())}") from None
 

@@ -21,6 +21,7 @@ from imitwalk.errors import RobotError, unknown_name
 from imitwalk.robots.assemble import plan_additions
 from imitwalk.robots.build import Additions, compile_model
 from imitwalk.robots.jointmap import JointMap, load_joint_map, parse_joint_map
+from imitwalk.robots.plausible import check_masses, check_standing
 from imitwalk.robots.rolenames import ARM_ROLES, LEG_ROLES, ROLES, SIDES, TRUNK_ROLES
 from imitwalk.robots.servos import actuator_kind, torque_limit
 
@@ -130,6 +131,8 @@ class Robot:
 
 def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Additions) -> Robot:
     roles, mj_joints, signs = res.roles, res.joints, np.array(res.signs)
+    root = int(model.body_rootid[model.body(res.torso).id])
+    check_masses(model, mjcf, float(model.body_subtreemass[root]))
     data = mujoco.MjData(model)
     key = jm.stand_keyframe
     if key is not None:
@@ -174,8 +177,12 @@ def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Addit
                 model.actuator_ctrlrange[a] if model.actuator_ctrllimited[a] else (-np.inf, np.inf)
             )
             ctrl[a] = np.clip(data.qpos[model.jnt_qposadr[j]], lo, hi)
-    root = int(model.body_rootid[model.body(res.torso).id])
     sole_z = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
+    mass, height = float(model.body_subtreemass[root]), _top(model, data) - sole_z
+    torso_z = float(data.xpos[model.body(res.torso).id][2] - sole_z)
+    check_standing(
+        mjcf, height=height, torso_height=torso_z, roles=roles, limits=limits, kp=np.array(kp)
+    )
     return cls(
         name=jm.name or mjcf.stem,
         mjcf=mjcf,
@@ -192,9 +199,9 @@ def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Addit
         limits=limits,
         kp=np.array(kp),
         torque_limit=np.array(tl),
-        total_mass=float(model.body_subtreemass[root]),
-        torso_height=float(data.xpos[model.body(res.torso).id][2] - sole_z),
-        height=_top(model, data) - sole_z,
+        total_mass=mass,
+        torso_height=torso_z,
+        height=height,
         sensors=tuple(s for s in _names(model, mujoco.mjtObj.mjOBJ_SENSOR, model.nsensor) if s),
         additions=add,
         stand_ctrl=ctrl,

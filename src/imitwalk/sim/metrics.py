@@ -47,8 +47,14 @@ class WalkMetrics:
             commanded heading of the moment, for a turning reference).
         forward_speed_mps: that distance over the time walked [m/s].
         progress_ratio: forward distance ÷ the distance the reference commands over
-            the same time (stride per cycle × cycles executed); for a reference that
-            steps on the spot, the turn (or else the sidestep) made ÷ the one commanded.
+            the duration it is judged on (``expected_distance``); for a reference that
+            steps on the spot, the turn (or else the sidestep) made ÷ the one commanded
+            over the whole ``track``. 1 is the commanded walk; 0 is no travel; it is
+            negative for a robot that went backwards. Judged over the whole duration
+            asked for (as ``evaluate`` does), a walk that falls after ``t`` seconds scores
+            at most what it walked by then, and one that falls at once scores about 0
+            (at most its standing height over the whole walk's distance) rather than its
+            fall's few centimetres over the few millimetres commanded so far.
         lateral_drift_m: sideways torso travel beyond the commanded sidestep [m];
         yaw_drift_deg: heading change beyond the commanded turn [deg].
         gyro_rms: RMS of the torso angular velocity norm [rad/s].
@@ -92,14 +98,19 @@ def walk_metrics(
 
     Args:
         rollout: a :class:`~imitwalk.sim.types.Rollout`.
-        expected_distance: distance the reference commands over the rollout's
-            duration [m] (the denominator of ``progress_ratio``).
+        expected_distance: distance the reference commands [m] (the denominator of
+            ``progress_ratio``): over the duration the walk is judged on, the rollout's
+            own (a learner's or a search's walk, which may end early on purpose) or the
+            whole duration asked for (``evaluate``: a fall then scores the share of the
+            whole walk made).
         q_ref: ``(N, n)`` reference joint angles to compare the measured ones with;
             defaults to the commanded targets.
         track: ``(T, 3)`` the commanded forward and sideways travel [m] and heading
             [rad] per control tick (:meth:`~imitwalk.retarget.reference.Reference.track`);
             ``None``: straight ahead. Distances are measured along the commanded
-            heading of each tick, and drifts are what is left beyond the command.
+            heading of each tick, and drifts are what is left beyond the command of
+            the last tick walked; a ``track`` longer than the rollout (the whole judged
+            duration) sets the turn or sidestep an on-the-spot ``progress_ratio`` is over.
     """
     pos, quat = rollout.torso_pos, rollout.torso_quat
     if len(pos) == 0:
@@ -116,12 +127,13 @@ def walk_metrics(
     lat = float(np.sum(-d[:, 0] * np.sin(h) + d[:, 1] * np.cos(h)) - cmd[-1, 1])
     tail = max(1, int(round(1.0 / rollout.control_dt)))
     yaw_drift = float(np.degrees(np.mean(yaw[-tail:] - cmd[-tail:, 2]) - head))
+    whole = track[-1] if track is not None and len(track) else cmd[-1]  # (3,) commanded
     if expected_distance > 0:
         progress = fwd / expected_distance
-    elif abs(cmd[-1, 2]) > 0:  # a turn on the spot: how much of the turn was made
-        progress = 1.0 + np.radians(yaw_drift) / cmd[-1, 2]
-    elif abs(cmd[-1, 1]) > 0:  # a sidestep on the spot
-        progress = 1.0 + lat / cmd[-1, 1]
+    elif abs(whole[2]) > 0:  # a turn on the spot: how much of the whole turn was made
+        progress = _share(np.radians(yaw_drift), cmd[-1, 2], whole[2])
+    elif abs(whole[1]) > 0:  # a sidestep on the spot
+        progress = _share(lat, cmd[-1, 1], whole[1])
     else:
         progress = 0.0
     seconds = rollout.seconds
@@ -145,6 +157,12 @@ def walk_metrics(
         commanded_turn_deg=float(np.degrees(cmd[-1, 2])),
         commanded_side_m=float(cmd[-1, 1]),
     )
+
+
+def _share(beyond: float, now: float, whole: float) -> float:
+    """The share of ``whole`` made: ``now`` (commanded so far) plus ``beyond`` (the drift
+    past it), over ``whole`` (commanded over the judged duration; ``now`` if the same)."""
+    return 1.0 + beyond / now if whole == now else (now + beyond) / whole
 
 
 #: A servo is saturated when it gives at least this fraction of its torque limit.
