@@ -109,8 +109,8 @@ class StepLearnConfig:
     def budget(self) -> float:
         """Simulated seconds the run walks at most [s]."""
         gen = self.generations * self.population * self.robots * self.seconds
-        final = (self.generations + 1) * self.final_robots * self.final_seconds
-        return gen + final
+        final = ((self.generations + 1) * self.final_robots + 1) * self.final_seconds
+        return gen + (final if self.final_robots else 0.0)
 
 
 @dataclass(frozen=True)
@@ -263,9 +263,15 @@ def learn_step(
         kept = finalists[best]
         fell = f"{final[best]['falls']}/{cfg.final_robots}"
         say(f"learn: kept {best} ({fell} fell on the final robots)")
-        if final[best]["falls"] == cfg.final_robots:
+        # the nominal robot (no factor drawn) walks the kept gains once: a robot or clip
+        # the stepping gait cannot walk at all is told so
+        nominal = protocol.only(()).draw(FINAL_FIRST, robot, seconds=cfg.final_seconds)
+        walk = _walk_all([kept], [nominal], robot, styles, long)[0][0]
+        spent += walk.seconds
+        if walk.fell:
             say(
-                f"learn: warning: the kept gains fell on all {cfg.final_robots} final robots; "
-                "for this robot or clip try `--variant extended` (the per-tick learner)"
+                "learn: warning: the kept gains fall on the nominal robot at "
+                f"{walk.fall_time_s:.1f} s; for this robot or clip try `--variant extended` "
+                "(the per-tick learner)"
             )
     return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)
