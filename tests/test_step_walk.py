@@ -163,3 +163,19 @@ def test_a_stepping_run_names_the_robot_file_it_learned_on(gait, tmp_path):
         tmp_path / "style.json"
     )
     assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/x/op3.json", None)
+
+
+def test_a_gait_file_carries_its_format_and_a_newer_one_is_refused(gait, tmp_path):
+    from imitwalk.errors import RunError
+    from imitwalk.step.gait import GAIT_FORMAT, StepGait
+
+    path = gait.save(tmp_path / "style.json")
+    d = json.loads(path.read_text())
+    assert d["format"] == GAIT_FORMAT
+    del d["format"]  # a file written before versions reads as format 1
+    path.write_text(json.dumps(d))
+    assert StepGait.load(path).to_dict() == gait.to_dict()
+    d["format"] = GAIT_FORMAT + 1
+    path.write_text(json.dumps(d))
+    with pytest.raises(RunError, match="newer imitwalk"):
+        StepGait.load(path)

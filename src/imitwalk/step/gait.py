@@ -16,13 +16,18 @@ from pathlib import Path
 
 import numpy as np
 
+from imitwalk import readback
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.sim.types import SimOptions
 from imitwalk.step.schedule import START_STEPS, nominal_distance, start_seconds
 from imitwalk.step.style import GaitStyle
 
-__all__ = ["StepGait"]
+#: The format version ``style.json`` is written in (and the newest :meth:`StepGait.load`
+#: reads; a file without one reads as 1).
+GAIT_FORMAT = 1
+
+__all__ = ["GAIT_FORMAT", "StepGait"]
 
 
 @dataclass
@@ -100,8 +105,9 @@ class StepGait:
 
     # -- persistence ------------------------------------------------------------
     def to_dict(self) -> dict:
-        """Plain-JSON dictionary."""
+        """Plain-JSON dictionary (with its ``format``, :data:`GAIT_FORMAT`)."""
         return {
+            readback.FORMAT_KEY: GAIT_FORMAT,
             "style": self.style.to_dict(),
             "robot": self.robot,
             "dt": self.dt,
@@ -121,6 +127,9 @@ class StepGait:
         path = Path(path)
         try:
             d = json.loads(path.read_text())
+            if not isinstance(d, dict):
+                raise TypeError(f"a JSON {type(d).__name__}, not an object")
+            readback.check_format(d, GAIT_FORMAT, str(path), RunError)
             return cls(
                 style=GaitStyle.from_dict(d["style"]),
                 robot=str(d["robot"]),
