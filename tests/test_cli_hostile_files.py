@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from file_fuzz import SUMMARY
 from imitwalk import __version__
 from imitwalk.cli.main import main
 
@@ -131,16 +132,6 @@ def test_learn_refuses_a_broken_reference_before_making_its_folder(tmp_path, cap
 
 
 # --- run folders: evaluate, report, learn --resume
-
-SUMMARY = {
-    "learner": "step",
-    "scale_reached": 1.0,
-    "scales_passed": [1.0],
-    "iterations": 1,
-    "sim_seconds_used_for_learning": 1.0,
-    "wall_seconds_for_learning": 1.0,
-    "config": {},
-}
 
 
 def _run(tmp_path: Path, **files) -> Path:

@@ -222,14 +222,14 @@ def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     """evaluate and report load the robot a run's reference records (a file), not its name."""
     from dataclasses import replace
 
-    from imitwalk.cli.commands import _run_robot
+    from imitwalk.cli.robot_args import run_robot
     from imitwalk.runs import RunDir
 
     ref, _ = tiny_reference  # shared: a copy with other settings
     settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
     replace(ref, settings=settings).save(tmp_path / "reference.npz")
     (tmp_path / "config.json").write_text(json.dumps({"robot": "op3"}))
-    assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)
+    assert run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)
 
 
 def test_importing_hoap2_gives_back_its_own_joint_map(tmp_path, capsys):

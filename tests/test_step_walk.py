@@ -156,13 +156,13 @@ def test_a_stepping_run_names_the_robot_file_it_learned_on(gait, tmp_path):
     stepping gait records, not by the robot's name in ``config.json``."""
     from dataclasses import replace
 
-    from imitwalk.cli.commands import _run_robot
+    from imitwalk.cli.robot_args import run_robot
     from imitwalk.runs import RunDir
 
     replace(gait, settings={"robot": "/x/op3.json", "joint_map": None}).save(
         tmp_path / "style.json"
     )
-    assert _run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/x/op3.json", None)
+    assert run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/x/op3.json", None)
 
 
 def test_a_gait_file_carries_its_format_and_a_newer_one_is_refused(gait, tmp_path):

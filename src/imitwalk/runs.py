@@ -21,7 +21,7 @@ import numpy as np
 
 from imitwalk import readback
 from imitwalk.errors import RunError
-from imitwalk.fileio import atomic_write, writable_folder
+from imitwalk.fileio import atomic_write, check_writable, writable_folder
 
 __all__ = ["RUN_FORMAT", "LearnSummary", "RunDir"]
 
@@ -133,13 +133,10 @@ class RunDir:
         ``flag`` names the folder's command-line argument in the message."""
         if self.path.exists() and not self.path.is_dir():
             raise RunError(f"{self.path} is a file, not a run folder; choose another {flag}")
-        folder = self.path if self.path.is_dir() else self.path.parent
-        if not folder.exists():
-            raise RunError(f"{flag} {self.path}: folder {folder} does not exist; create it first")
-        if not folder.is_dir():
-            raise RunError(f"{flag} {self.path}: {folder} is a file, not a folder")
-        if not writable_folder(folder):
-            raise RunError(f"{flag} {self.path}: cannot write in {folder}; choose another {flag}")
+        if not self.path.is_dir():  # a new folder: its parent as for any new file
+            check_writable(self.path, flag, RunError)
+        elif not writable_folder(self.path):
+            raise RunError(f"{flag} {self.path}: cannot write in it; choose another {flag}")
 
     def file(self, name: str) -> Path:
         """Path of a file in the run folder."""

@@ -8,46 +8,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import recorded_robot, robot_from, standing_robot
 
 if TYPE_CHECKING:
     from imitwalk.runs import LearnSummary
 
-__all__ = [
-    "playback",
-    "retarget",
-    "robot_from",
-    "robot_label",
-    "standing_robot",
-]
-
-
-def robot_from(args: argparse.Namespace):
-    """Load the robot named by ``--robot`` / ``--joint-map`` (or the positional ``robot``)."""
-    from imitwalk.robots import load_robot
-
-    return load_robot(args.robot, getattr(args, "joint_map", None))
-
-
-def robot_label(args: argparse.Namespace) -> str:
-    """The robot as the command line gave it: ``--robot`` (or the positional robot), and
-    ``--joint-map`` if given."""
-    jm = getattr(args, "joint_map", None)
-    return str(args.robot) + (f" (joint map {jm})" if jm else "")
-
-
-def standing_robot(args: argparse.Namespace):
-    """:func:`robot_from`, refused at once if it cannot stand: the stand check of
-    :mod:`imitwalk.sim.standing` (a 2 s hold of the nominal robot, well under a second of
-    computing), so that ``learn`` never spends minutes on a robot that falls standing still.
-
-    Raises:
-        RobotError: one line with the tilt or height measured and the joint-map keys to change.
-    """
-    from imitwalk.sim.standing import require_standing
-
-    robot = robot_from(args)
-    require_standing(robot, robot_label(args))
-    return robot
+__all__ = ["demo", "learn", "playback", "retarget"]
 
 
 def _motion(args: argparse.Namespace):
@@ -79,21 +45,12 @@ def retarget(args: argparse.Namespace) -> int:
     _announce_search(cfg)
     res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
     progress(f"  cycles: {res.template.meta['cycles_report']}")
-    res.reference.settings["robot"] = _where(args.robot)
-    res.reference.settings["joint_map"] = _where(args.joint_map)
+    res.reference.settings.update(recorded_robot(args))
     res.reference.save(args.out)
     stats = res.stats()
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
-
-
-def _where(robot: str | None) -> str | None:
-    """A robot as a reference records it: a built-in name as it is, a file as an absolute
-    path (so that the reference plays from any working directory)."""
-    if robot is None or not Path(robot).is_file():
-        return robot
-    return str(Path(robot).resolve())
 
 
 def _announce_search(cfg) -> None:
@@ -210,8 +167,7 @@ def learn(args: argparse.Namespace) -> int:
             progress(f"learn: retargeting {motion.source}")
             res = do_retarget(motion, robot, rcfg, search_report, refine_report, walker=walker)
             progress(f"  cycles: {res.template.meta['cycles_report']}")
-            res.reference.settings["robot"] = _where(args.robot)
-            res.reference.settings["joint_map"] = _where(args.joint_map)
+            res.reference.settings.update(recorded_robot(args))
             return res.reference
 
         if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
@@ -279,8 +235,7 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
         f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "
         f"(at most {cfg.budget():.0f} simulated seconds)"
     )
-    where = {"robot": _where(args.robot), "joint_map": _where(args.joint_map)}
-    summary = learn(motion, robot, args.out, cfg, args.resume, progress, where)
+    summary = learn(motion, robot, args.out, cfg, args.resume, progress, recorded_robot(args))
     return _learned(summary, args, rd)
 
 
@@ -295,101 +250,8 @@ def _learned(summary: LearnSummary, args: argparse.Namespace, rd, choice=None) -
     return 0
 
 
-def evaluate(args: argparse.Namespace) -> int:
-    from imitwalk.errors import ConfigError
-    from imitwalk.judge.protocol import load_protocol
-    from imitwalk.judge.verdict import judge_protocol
-    from imitwalk.robots.urdf import rotor_note
-    from imitwalk.runs import RunDir
-
-    rd = RunDir(args.run_dir)
-    cfg = rd.read_json("config.json")
-    rd.check_writable("RUN_DIR")  # the verdict is written there
-    if args.robot is None:
-        args.robot, args.joint_map = _run_robot(rd, cfg)
-    robot = robot_from(args)
-    if args.push_recovery:
-        return _push_recovery(args, rd, robot)
-    protocol = load_protocol(args.protocol)
-    if args.seeds < 1 or not args.seconds > 0:
-        raise ConfigError(
-            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
-        )
-    chosen = tuple(args.controllers.split(",")) if args.controllers else None
-    progress(
-        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
-        f"{args.seeds} robots x {args.seconds:g} s"
-    )
-    if protocol.engine == "bullet":
-        progress(f"evaluate: note: {rotor_note(robot)}")
-    out = judge_protocol(
-        rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
-        scale=args.scale, workers=args.workers, explain=args.explain_falls,
-    )  # fmt: skip
-    for name, side in out.controllers.items():
-        lo, hi = side.survival_ci95
-        progress(
-            f"  {name:>10}: survived {side.survived}/{side.robots} "
-            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side.distance_m:.2f} m, "
-            f"|yaw| {side.abs_yaw_deg:.1f} deg"
-        )
-        if (line := side.explained()) is not None:
-            progress(f"  {'':>10}  falls saved by one factor at nominal: {line}")
-    scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    rd.write_json(f"protocol_{protocol.name}{scale}.json", out.to_dict())
-    emit(out.to_dict(), args.json)
-    return 0
-
-
-def _run_robot(rd, cfg: dict) -> tuple[str, str | None]:
-    """The robot a run learned on and its joint map: the file its reference or its
-    stepping gait records (a built-in name, or the joint map's path), else the name in
-    its ``config.json``."""
-    from imitwalk.retarget import Reference
-    from imitwalk.step.gait import StepGait
-
-    settings: dict = {}
-    if rd.exists("reference.npz"):
-        settings = Reference.load(rd.file("reference.npz")).settings
-    elif rd.exists("style.json"):
-        settings = StepGait.load(rd.file("style.json")).settings
-    name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
-    return name or "hoap2", settings.get("joint_map")
-
-
-def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
-    from imitwalk.judge.pushes import push_recovery
-
-    progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")
-    chosen = tuple(args.controllers.split(",")) if args.controllers else None
-    out = push_recovery(rd.path, robot, controllers=chosen, scale=args.scale, workers=args.workers)
-    for name, side in out.controllers.items():
-        least = side.min_by_direction.items()
-        progress(
-            f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
-        )
-    rd.write_json("push_recovery.json", out.to_dict())
-    emit(out.to_dict(), args.json)
-    return 0
-
-
 def demo(args: argparse.Namespace) -> int:
     from imitwalk.cli.demo import run_demo
 
     emit(run_demo(Path(args.out)), args.json)
-    return 0
-
-
-def report(args: argparse.Namespace) -> int:
-    from imitwalk.evidence.report import write_report
-    from imitwalk.runs import RunDir
-
-    rd = RunDir(args.run_dir)
-    rd.read_summary()  # a clear error if this is not a finished run
-    rd.check_writable("RUN_DIR")  # report.html is written there
-    robot = None
-    if args.robot:
-        robot = robot_from(args)
-    path = write_report(rd.path, robot, seconds=args.seconds, progress=progress)
-    emit({"report": str(path)}, args.json)
     return 0

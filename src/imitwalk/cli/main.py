@@ -12,7 +12,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from imitwalk.cli import commands, robot_commands
+from imitwalk.cli import commands, judge_commands, robot_commands
 from imitwalk.errors import ImitwalkError
 from imitwalk.judge.protocol import PROTOCOLS
 from imitwalk.sim.types import ENGINES
@@ -210,14 +210,14 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     ev.add_argument("--workers", type=int, default=None, help="parallel processes")
     ev.add_argument("--json", action="store_true", help="print JSON")
-    ev.set_defaults(func=commands.evaluate)
+    ev.set_defaults(func=judge_commands.evaluate)
     rp = sub.add_parser("report", help="write RUN_DIR/report.html (figures, film strips, video)")
     rp.add_argument("run_dir", help="a run folder written by learn")
     rp.add_argument("--seconds", type=float, default=10.0, help="length of the replays (10)")
     rp.add_argument("--robot", default=None, help="robot (default: the run's)")
     rp.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     rp.add_argument("--json", action="store_true", help="print JSON")
-    rp.set_defaults(func=commands.report)
+    rp.set_defaults(func=judge_commands.report)
 
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")

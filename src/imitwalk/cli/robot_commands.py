@@ -6,8 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
-from imitwalk.cli.commands import robot_from, robot_label
 from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import robot_from, robot_label
 
 __all__ = ["robot_import", "robot_info", "robot_stand"]
 

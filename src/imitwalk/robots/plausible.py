@@ -58,6 +58,13 @@ JOINT_RANGE_RAD: tuple[float, float] = (-2 * math.pi, 2 * math.pi)
 SERVO_KP: tuple[float, float] = (0.0, 1e5)
 
 
+def _within(where: str, what: str, value: float, bounds: tuple[float, float], unit: str):
+    """Refuse ``value`` [``unit``] outside ``bounds`` (inclusive), in one line."""
+    lo, hi = bounds
+    if not lo <= value <= hi:
+        raise RobotError(f"{where}: {what} {value:.4g} {unit} is outside {lo:g}-{hi:g} {unit}")
+
+
 def check_masses(model: mujoco.MjModel, mjcf: Path, total_mass: float) -> None:
     """Refuse a model whose total mass [kg], a body's mass or inertia, or timestep is
     outside the bounds of this module (before any physics runs on it).
@@ -66,9 +73,7 @@ def check_masses(model: mujoco.MjModel, mjcf: Path, total_mass: float) -> None:
         RobotError: one line naming the file, the value and the accepted range.
     """
     where = mjcf.name
-    lo, hi = TOTAL_MASS_KG
-    if not lo <= total_mass <= hi:
-        raise RobotError(f"{where}: total mass {total_mass:.4g} kg is outside {lo:g}-{hi:g} kg")
+    _within(where, "total mass", total_mass, TOTAL_MASS_KG, "kg")
     for b in range(1, model.nbody):
         name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"#{b}"
         if model.body_mass[b] > BODY_MASS_KG:
@@ -81,9 +86,7 @@ def check_masses(model: mujoco.MjModel, mjcf: Path, total_mass: float) -> None:
                 f"{where}: body {name!r} has an inertia of {model.body_inertia[b].max():.4g} "
                 f"kg m^2; expected at most {BODY_INERTIA_KGM2:g} kg m^2"
             )
-    lo, hi = TIMESTEP_S
-    if not lo <= model.opt.timestep <= hi:
-        raise RobotError(f"{where}: timestep {model.opt.timestep:.4g} s is outside {lo:g}-{hi:g} s")
+    _within(where, "timestep", float(model.opt.timestep), TIMESTEP_S, "s")
 
 
 def check_standing(
@@ -109,9 +112,7 @@ def check_standing(
         RobotError: one line naming the file, the value and the accepted range.
     """
     where = mjcf.name
-    lo, hi = HEIGHT_M
-    if not lo <= height <= hi:
-        raise RobotError(f"{where}: standing height {height:.4g} m is outside {lo:g}-{hi:g} m")
+    _within(where, "standing height", height, HEIGHT_M, "m")
     if not 0.0 < torso_height <= height:
         raise RobotError(
             f"{where}: the torso stands {torso_height:.4g} m above the soles; expected "

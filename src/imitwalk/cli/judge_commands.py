@@ -1,0 +1,88 @@
+"""The judging commands: ``evaluate`` (a protocol's robots, or push recovery) and
+``report`` (the run's HTML page)."""
+
+from __future__ import annotations
+
+import argparse
+
+from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import robot_from, run_robot
+
+__all__ = ["evaluate", "report"]
+
+
+def evaluate(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.robots.urdf import rotor_note
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    cfg = rd.read_json("config.json")
+    rd.check_writable("RUN_DIR")  # the verdict is written there
+    if args.robot is None:
+        args.robot, args.joint_map = run_robot(rd, cfg)
+    robot = robot_from(args)
+    if args.push_recovery:
+        return _push_recovery(args, rd, robot)
+    protocol = load_protocol(args.protocol)
+    if args.seeds < 1 or not args.seconds > 0:
+        raise ConfigError(
+            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
+        )
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    progress(
+        f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
+        f"{args.seeds} robots x {args.seconds:g} s"
+    )
+    if protocol.engine == "bullet":
+        progress(f"evaluate: note: {rotor_note(robot)}")
+    out = judge_protocol(
+        rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
+        scale=args.scale, workers=args.workers, explain=args.explain_falls,
+    )  # fmt: skip
+    for name, side in out.controllers.items():
+        lo, hi = side.survival_ci95
+        progress(
+            f"  {name:>10}: survived {side.survived}/{side.robots} "
+            f"({100 * lo:.0f}-{100 * hi:.0f} %), {side.distance_m:.2f} m, "
+            f"|yaw| {side.abs_yaw_deg:.1f} deg"
+        )
+        if (line := side.explained()) is not None:
+            progress(f"  {'':>10}  falls saved by one factor at nominal: {line}")
+    scale = "" if args.scale is None else f"_scale{args.scale:g}"
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", out.to_dict())
+    emit(out.to_dict(), args.json)
+    return 0
+
+
+def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
+    from imitwalk.judge.pushes import push_recovery
+
+    progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")
+    chosen = tuple(args.controllers.split(",")) if args.controllers else None
+    out = push_recovery(rd.path, robot, controllers=chosen, scale=args.scale, workers=args.workers)
+    for name, side in out.controllers.items():
+        least = side.min_by_direction.items()
+        progress(
+            f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
+        )
+    rd.write_json("push_recovery.json", out.to_dict())
+    emit(out.to_dict(), args.json)
+    return 0
+
+
+def report(args: argparse.Namespace) -> int:
+    from imitwalk.evidence.report import write_report
+    from imitwalk.runs import RunDir
+
+    rd = RunDir(args.run_dir)
+    rd.read_summary()  # a clear error if this is not a finished run
+    rd.check_writable("RUN_DIR")  # report.html is written there
+    robot = None
+    if args.robot:
+        robot = robot_from(args)
+    path = write_report(rd.path, robot, seconds=args.seconds, progress=progress)
+    emit({"report": str(path)}, args.json)
+    return 0
