@@ -31,13 +31,20 @@ def test_an_unknown_name_is_an_attribute_error():
         imitwalk.learn_step  # noqa: B018
 
 
-def _readme_python() -> str:
+def _readme_python() -> list[str]:
     blocks = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-    assert len(blocks) == 1, "the README has one Python example"
-    return blocks[0]
+    assert len(blocks) == 2, "the README has two Python examples: the library, the environment"
+    return blocks
 
 
 @pytest.mark.slow
 def test_the_readmes_python_example_runs(tmp_path):
-    subprocess.run([sys.executable, "-c", _readme_python()], check=True, cwd=tmp_path)
+    subprocess.run([sys.executable, "-c", _readme_python()[0]], check=True, cwd=tmp_path)
     assert (tmp_path / "RUN" / "metrics.json").exists()
+
+
+@pytest.mark.slow
+def test_the_readmes_environment_example_runs(tmp_path):
+    out = subprocess.run([sys.executable, "-c", _readme_python()[1]], check=True, cwd=tmp_path,
+                         capture_output=True, text=True)  # fmt: skip
+    assert "alive" in out.stdout

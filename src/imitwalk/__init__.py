@@ -66,6 +66,11 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "ProtocolVerdict": "imitwalk.judge.records",
     "PushVerdict": "imitwalk.judge.records",
     "write_report": "imitwalk.evidence.report",
+    "WalkConfig": "imitwalk.envs.setup",
+    "WalkEnv": "imitwalk.envs.walk",
+    "PPOConfig": "imitwalk.envs.ppo",
+    "train_ppo": ("imitwalk.envs.ppo", "train"),
+    "PolicyActor": "imitwalk.rl.actor",
 }
 
 

@@ -46,7 +46,7 @@ def _json_default(v):
 _TICK_ONLY = ("trial_scale", "trial_falls", "feedback_gains", "trust", "reference_settings")
 _FAITHFUL_ONLY = ("variant", "gait")
 _STEP_ONLY = ("gains", "final")
-_ONLY = {"tick": _TICK_ONLY, "faithful": _FAITHFUL_ONLY, "step": _STEP_ONLY}
+_ONLY = {"tick": _TICK_ONLY, "faithful": _FAITHFUL_ONLY, "step": _STEP_ONLY, "rl": ()}
 
 
 #: The types of the fields every learner writes to ``metrics.json``.
@@ -66,8 +66,9 @@ class LearnSummary:
     """What a learner reached and what it cost: the record behind ``metrics.json``.
 
     Attributes:
-        learner: ``"step"`` (the stepping gait), ``"tick"`` (the per-tick learner) or
-            ``"faithful"`` (the paper's, as written).
+        learner: ``"step"`` (the stepping gait), ``"tick"`` (the per-tick learner),
+            ``"faithful"`` (the paper's, as written) or ``"rl"`` (PPO,
+            :mod:`imitwalk.envs.ppo`).
         scale_reached: the largest stride scale learned; scales_passed: every scale passed.
         iterations: learning iterations run (schedule iterations for ``tick``).
         sim_seconds_used_for_learning: simulated time of every learning walk [s];

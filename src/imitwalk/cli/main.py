@@ -12,7 +12,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from imitwalk.cli import commands, judge_commands, robot_commands
+from imitwalk.cli import commands, judge_commands, rl_commands, robot_commands
 from imitwalk.errors import ImitwalkError
 from imitwalk.judge.protocol import PROTOCOLS
 from imitwalk.sim.types import ENGINES
@@ -218,6 +218,8 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     rp.add_argument("--json", action="store_true", help="print JSON")
     rp.set_defaults(func=judge_commands.report)
+
+    rl_commands.add_parser(sub, PROTOCOLS)
 
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")

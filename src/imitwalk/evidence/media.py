@@ -218,8 +218,8 @@ def replay(run_: LoadedRun, robot: Robot, seconds: float, scale: float | None = 
     return Replays(scale, before, after, actions)
 
 
-def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int):
-    """One kick, rendered: the learned controller on the nominal robot kicked to the left
+def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int, controller: str = "learned"):
+    """One kick, rendered: ``controller`` on the nominal robot kicked to the left
     at the left heel strike two cycles after the start-up, by half the hard protocol's
     largest kick; ``count`` images over the 1.5 s after it. Returns (figure, caption)."""
     from imitwalk.judge.pushes import kick_time, top_speed
@@ -230,13 +230,13 @@ def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int):
     dv = (t, -speed * np.sin(heading), speed * np.cos(heading))
     seconds = t + 1.5
     opts = ref.sim_options(SimOptions(pushes=(dv,)))
-    policy = run_.policy("learned", robot, run_.scale, seconds)
+    policy = run_.policy(controller, robot, run_.scale, seconds)
     steps = round(seconds / ref.dt)
     ro = run(make_plant(robot, opts, run_.engine), policy, steps, stop_on_fall=False)
     idx = np.linspace(round(t / ref.dt), len(ro.qpos) - 1, count).astype(int)
     images = [renderer.frame(ro.qpos[i]) for i in idx]
     titles = [f"t = {ro.t[i]:.2f} s" for i in idx]
-    label = f"learned controller, kicked {speed:.2f} m/s to the left at t = {t:.2f} s"
+    label = f"{controller} controller, kicked {speed:.2f} m/s to the left at t = {t:.2f} s"
     fig = plots.film_strip(images, titles, label)
     return fig, f"A kick of {speed:.2f} m/s to the left; the robot {outcome(ro)}."
 

@@ -69,7 +69,7 @@ def write_report(
     config = rd.read_json("config.json")
     where = lg.ref.settings.get("robot") or config.get("robot", lg.ref.robot)  # a file, or a name
     robot = robot or load_robot(where, lg.ref.settings.get("joint_map"))
-    if lg.learner == "step":
+    if lg.learner in ("step", "rl"):
         from imitwalk.evidence.step_report import write_step_report
 
         return write_step_report(run_dir, lg, robot, seconds, progress, s)

@@ -1,4 +1,4 @@
-"""A stepping run's report: one self-contained HTML page, viewable offline.
+"""A stepping or PPO run's report: one self-contained HTML page, viewable offline.
 
 The stepping gait has no joint-space loop for the paper's Figs. 3–7 (those are a
 per-tick or faithful run's report, :mod:`imitwalk.evidence.report`). Its page shows:
@@ -6,7 +6,9 @@ the walk from standing on the nominal robot with the shipped gains and the learn
 ones, side by side (video); the human demonstration beside the robot, and the style's
 cadence and stride beside what the robot's sole forces measured; every protocol the
 run was judged on; push recovery and one kick; the learning curve; the path from above;
-the configuration.
+the configuration. A PPO run's page (:mod:`imitwalk.envs.ppo`) shows the stepping gait it
+was trained beside and its policy in place of the two gains, and its episode lengths
+as the learning curve.
 """
 
 from __future__ import annotations
@@ -27,17 +29,30 @@ from imitwalk.sim.mujoco import Rollout, make_plant, run
 
 __all__ = ["imitation_rows", "write_step_report"]
 
-#: The two walks shown: the shipped gains, then the learned ones.
+#: The two walks shown: the shipped gains, then the learned ones (a PPO run: the
+#: stepping gait it was trained beside, then its policy).
 SHOWN = ("default", "learned")
+SHOWN_RL = ("default", "rl")
+
+
+def shown(lg: LoadedRun) -> tuple[str, str]:
+    """The two controllers a report shows, the learned one last."""
+    return SHOWN_RL if lg.learner == "rl" else SHOWN
+
+
+def _label(lg: LoadedRun, name: str) -> str:
+    if lg.learner == "rl":
+        return "PPO policy" if name == "rl" else "stepping gait"
+    return f"{name} gains"
 
 
 def _replays(lg: LoadedRun, robot: Robot, seconds: float) -> list[tuple[str, Rollout]]:
     out = []
-    for name in SHOWN:
+    for name in shown(lg):
         policy = lg.policy(name, robot, lg.scale, seconds)
         plant = make_plant(robot, lg.ref.sim_options(), lg.engine)
         steps = round(seconds / lg.ref.dt)
-        out.append((f"{name} gains", run(plant, policy, steps, stop_on_fall=False)))
+        out.append((_label(lg, name), run(plant, policy, steps, stop_on_fall=False)))
     return out
 
 
@@ -83,10 +98,28 @@ def _imitation(lg: LoadedRun, robot: Robot, runs, strip: str) -> str:
     return figure(strip, caption) + "<table>" + head + body + "</table>" + note
 
 
+def _learning_rl(log: list[dict], lg: LoadedRun) -> str:
+    m = lg.metrics
+    fig = plots._figure(6.0, 3.0)
+    ax = fig.add_subplot(111)
+    rows = [e for e in log if e.get("episode_seconds") is not None]
+    ax.plot([e["sim_seconds"] for e in rows], [e["episode_seconds"] for e in rows], "-")
+    ax.set_xlabel("simulated seconds of experience")
+    ax.set_ylabel("mean episode length [s]")
+    caption = (
+        f"PPO: {m.iterations} rollouts on training robots; "
+        f"{m.sim_seconds_used_for_learning:.0f} s simulated, "
+        f"{m.wall_seconds_for_learning:.0f} s of wall time. An episode ends on a fall."
+    )
+    return figure(img(fig, "learning curve"), caption)
+
+
 def _learning(rd: RunDir, lg: LoadedRun) -> str:
     log, m = rd.read_log(), lg.metrics
     if not log:
         return '<p class="missing">No learning log.</p>'
+    if lg.learner == "rl":
+        return _learning_rl(log, lg)
     fig = plots._figure(6.0, 3.0)
     ax = fig.add_subplot(111)
     gens = [e["generation"] for e in log]
@@ -112,12 +145,13 @@ def _strips(lg: LoadedRun, robot: Robot, runs, rd: RunDir, s: media.ReportSettin
     renderer = Renderer(robot, s.strip_width, s.strip_height, *s.strip_camera)
     try:
         images, titles = media.robot_strip(renderer, runs[-1][1], lg.ref.period, s.strip_frames)
-        kick = media.kick_strip(renderer, lg, robot, s.strip_frames)
+        kick = media.kick_strip(renderer, lg, robot, s.strip_frames, shown(lg)[-1])
     finally:
         renderer.close()
     human, missing = media.human_strip(lg.ref, s.strip_frames)
     rows = [] if human is None else [(human, "film strip: human")]
-    robot_row = plots.film_strip(images, titles, "robot, learned gains (last gait cycle)")
+    last = _label(lg, shown(lg)[-1])
+    robot_row = plots.film_strip(images, titles, f"robot, {last} (last gait cycle)")
     rows.append((robot_row, "film strip: robot"))
     media.save_strip([f for f, _ in rows], rd.file("filmstrip.png"))
     strip = "".join(img(f, alt) for f, alt in rows)
@@ -144,7 +178,7 @@ def write_step_report(
     rd = RunDir(run_dir)
     gait = lg.step_gait
     seconds = max(seconds, gait.kick_time(0, 1) + 2 * gait.period)
-    say(f"report: replaying {seconds:g} s with the shipped and the learned gains")
+    say(f"report: replaying {seconds:g} s: " + " and ".join(_label(lg, n) for n in shown(lg)))
     runs = _replays(lg, robot, seconds)
     frames = media.video(robot, runs, seconds, s)
     mp4 = write_mp4(frames, rd.file("before_after.mp4"), s.fps)
@@ -179,7 +213,8 @@ def write_step_report(
     page = (
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}'
         f'</title><link rel="icon" href="data:,"><style>{STYLE}</style></head><body>\n'
-        f"<h1>{title}</h1>\n<p>stepping gait; {html.escape(Path(lg.ref.source).name)}; "
+        f"<h1>{title}</h1>\n<p>{'PPO policy' if lg.learner == 'rl' else 'stepping gait'}; "
+        f"{html.escape(Path(lg.ref.source).name)}; "
         f"report made in {time.perf_counter() - t0:.0f} s.</p>\n{body}</body></html>\n"
     )
     out = atomic_write(rd.file("report.html"), lambda tmp: tmp.write_text(page, "utf-8"))

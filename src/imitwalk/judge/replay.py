@@ -2,13 +2,16 @@
 
 :func:`load_run` reads a run folder of any learner: the stepping gait
 (:mod:`imitwalk.step`, the default), the per-tick balance learner
-(:mod:`imitwalk.balance.ticklearn`) or the paper's as written (``faithful``,
-:mod:`imitwalk.paper.learner`). Each gives a :class:`LoadedRun`: its gait (a stepping
-run's :class:`~imitwalk.step.gait.StepGait`, the others' joint-space reference), the scale
+(:mod:`imitwalk.balance.ticklearn`), the paper's as written (``faithful``,
+:mod:`imitwalk.paper.learner`) or PPO's (``rl``, :mod:`imitwalk.envs.ppo`). Each gives a
+:class:`LoadedRun`: its gait (a stepping or PPO run's :class:`~imitwalk.step.gait.StepGait`,
+the others' joint-space reference), the scale
 the run reached, the engine it learned on, and :meth:`~LoadedRun.policy`, a fresh
 controller by name. A stepping run builds ``learned`` and ``default`` (the gains imitwalk
-ships, where learning starts); the others build theirs and ``open_loop`` (the reference
-played as it is).
+ships, where learning starts); a PPO run builds ``rl`` (its policy,
+:class:`~imitwalk.rl.actor.PolicyActor`) and ``default`` (the stepping gait it was
+trained beside, a residual policy's base); the others build theirs and ``open_loop``
+(the reference played as it is).
 """
 
 from __future__ import annotations
@@ -58,7 +61,9 @@ class LoadedRun:
         play the reference as it is);
         gait: the faithful run's learned gait (:class:`~imitwalk.paper.evaluate.LearnedGait`);
         step_gains: a stepping run's gains by controller name
-        (:class:`~imitwalk.step.gains.StepGains`).
+        (:class:`~imitwalk.step.gains.StepGains`); a PPO run's ``default``.
+        actor: a PPO run's policy: its :class:`~imitwalk.rl.actor.ActorSpec` and
+        :class:`~imitwalk.rl.network.MLP`.
     """
 
     path: str
@@ -71,6 +76,7 @@ class LoadedRun:
     gait: LearnedGait | None = None
     settings: dict | None = None
     step_gains: dict | None = None
+    actor: tuple | None = None
 
     @property
     def reference(self) -> Reference:
@@ -96,6 +102,8 @@ class LoadedRun:
 
     def controllers(self) -> tuple[str, ...]:
         """The controllers it can build (a joint-space run's ``open_loop`` last)."""
+        if self.actor is not None:
+            return ("rl", *tuple(self.step_gains or ()))
         if self.step_gains is not None:
             return tuple(self.step_gains)
         names = tuple(self.laws) if self.laws is not None else ("learned",)
@@ -130,6 +138,17 @@ class LoadedRun:
             ConfigError: a controller this run cannot build (listing the ones it can).
         """
         scale = self.scale if scale is None else scale
+        if self.actor is not None and controller == "rl":
+            from imitwalk.rl.actor import PolicyActor
+            from imitwalk.step.controller import SteppingController
+
+            spec, net = self.actor
+            base = None
+            if spec.layout.action == "residual":
+                assert self.step_gains is not None
+                style = self.step_gait.at_scale(scale)
+                base = SteppingController(robot, style, self.step_gains["default"], self.ref.dt)
+            return PolicyActor(spec, net, base)
         if self.step_gains is not None:
             from imitwalk.step.controller import SteppingController
 
@@ -162,6 +181,28 @@ def load_run(run_dir) -> LoadedRun:
     if not isinstance(config, dict):
         raise RunError(f"{rd.file('config.json')} is not a run's settings (not a JSON object)")
     engine = str(config.get("learn", {}).get("engine", "mujoco"))
+    if config.get("learner") == "rl":
+        from imitwalk.rl.actor import ActorSpec
+        from imitwalk.rl.network import MLP
+        from imitwalk.step.gains import StepGains
+        from imitwalk.step.gait import StepGait
+
+        gait = StepGait.load(rd.file("style.json"))
+        try:
+            default = StepGains.from_dict(rd.read_json("gains.json")["default"])
+        except (KeyError, TypeError, ConfigError) as exc:
+            raise RunError(f"{rd.file('gains.json')} is not a PPO run's gains: {exc}") from None
+        actor = (ActorSpec.load(rd.file("actor.json")), MLP.load(rd.file("policy.npz")))
+        return LoadedRun(
+            str(rd.path),
+            "rl",
+            gait,
+            1.0,
+            engine,
+            metrics,
+            step_gains={"default": default},
+            actor=actor,
+        )
     if config.get("learner") == "step":
         from imitwalk.step.gains import StepGains
         from imitwalk.step.gait import StepGait

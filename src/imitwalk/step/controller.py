@@ -254,6 +254,11 @@ class SteppingController:
         w = float(np.clip(np.dot(self.zmp, d) / max(np.dot(d, d), 1e-9), 0.0, 1.0))
         return {self.stance: 1.0 - w, other: w}
 
+    @property
+    def phase(self) -> float:
+        """The gait phase ψ ∈ [0, 1) the controller is at (0 before its first tick)."""
+        return self._phase() if self._started else 0.0
+
     def _phase(self) -> float:
         """The gait phase ψ ∈ [0, 1) (0 at the left touchdown) for the arms and waist."""
         t = self.t_phase if not self.single else self.ds_time + self.t_phase

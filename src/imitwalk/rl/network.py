@@ -1,0 +1,111 @@
+"""A trained policy's network in NumPy: the deterministic action of a PPO actor.
+
+Stable-Baselines3's ``MlpPolicy`` computes its mean action as ``action_net(pi(x))``,
+``pi`` a stack of linear layers each followed by the activation (tanh by default).
+:class:`MLP` holds those layers' weights and evaluates them with NumPy, so a trained
+policy is judged, replayed and exported without PyTorch. :func:`from_sb3` copies them
+out of a trained model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from imitwalk.errors import ConfigError, RunError, unknown_name
+from imitwalk.fileio import atomic_write
+
+__all__ = ["ACTIVATIONS", "MLP", "from_sb3"]
+
+
+def _relu(x: np.ndarray) -> np.ndarray:
+    return np.maximum(x, 0.0)
+
+
+ACTIVATIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {"tanh": np.tanh, "relu": _relu}
+
+
+@dataclass(frozen=True)
+class MLP:
+    """Layers ``(W_i (out, in), b_i (out,))``: the activation after each but the last.
+
+    Attributes:
+        weights, biases: one per layer; activation: a name of :data:`ACTIVATIONS`.
+    """
+
+    weights: tuple[np.ndarray, ...]
+    biases: tuple[np.ndarray, ...]
+    activation: str = "tanh"
+
+    def __post_init__(self) -> None:
+        if self.activation not in ACTIVATIONS:
+            raise unknown_name("activation", self.activation, ACTIVATIONS, ConfigError)
+        if not self.weights or len(self.weights) != len(self.biases):
+            raise ConfigError("an MLP needs one bias per weight matrix, and at least one layer")
+
+    @property
+    def sizes(self) -> tuple[int, int]:
+        """``(inputs, outputs)``."""
+        return self.weights[0].shape[1], self.weights[-1].shape[0]
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """``(outputs,)`` for ``(inputs,)`` ``x``."""
+        act = ACTIVATIONS[self.activation]
+        h = np.asarray(x, dtype=np.float64)
+        last = len(self.weights) - 1
+        for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+            h = w @ h + b
+            if i < last:
+                h = act(h)
+        return h
+
+    def save(self, path: str | Path) -> Path:
+        """Write ``path`` (``.npz``) atomically."""
+        arrays: dict[str, Any] = {f"w{i}": w for i, w in enumerate(self.weights)}
+        arrays |= {f"b{i}": b for i, b in enumerate(self.biases)}
+        arrays["activation"] = np.array(self.activation)
+
+        def write(tmp: Path) -> None:
+            with open(tmp, "wb") as fh:
+                np.savez(fh, **arrays)
+
+        return atomic_write(path, write)
+
+    @classmethod
+    def load(cls, path: str | Path) -> MLP:
+        """Read a network :meth:`save` wrote (a one-line :class:`RunError` if it cannot)."""
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                n = sum(1 for k in z.files if k.startswith("w"))
+                weights = tuple(np.asarray(z[f"w{i}"], dtype=float) for i in range(n))
+                biases = tuple(np.asarray(z[f"b{i}"], dtype=float) for i in range(n))
+                act = str(z["activation"])
+        except FileNotFoundError:
+            raise RunError(f"{path} not found: is it a finished 'imitwalk rl' run?") from None
+        except (OSError, ValueError, KeyError) as exc:
+            raise RunError(f"{path} is not a policy network: {type(exc).__name__}: {exc}") from None
+        for i in range(n - 1):
+            if weights[i + 1].shape[1] != weights[i].shape[0] or biases[i].shape != (
+                weights[i].shape[0],
+            ):
+                raise RunError(f"{path}: layer {i + 1}'s shape does not follow layer {i}'s")
+        return cls(weights, biases, act)
+
+
+def from_sb3(model) -> MLP:
+    """The mean-action network of a Stable-Baselines3 ``PPO`` with an ``MlpPolicy`` whose
+    feature extractor is a plain flatten (the default)."""
+    import torch
+
+    pol = model.policy
+    layers = [m for m in pol.mlp_extractor.policy_net if isinstance(m, torch.nn.Linear)]
+    acts = {type(m).__name__ for m in pol.mlp_extractor.policy_net} - {"Linear"}
+    name = {"Tanh": "tanh", "ReLU": "relu"}.get(next(iter(acts), "Tanh"), "tanh")
+    layers.append(pol.action_net)
+    weights = tuple(layer.weight.detach().cpu().numpy().astype(float) for layer in layers)
+    biases = tuple(layer.bias.detach().cpu().numpy().astype(float) for layer in layers)
+    return MLP(weights, biases, name)
