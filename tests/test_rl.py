@@ -169,12 +169,12 @@ def test_a_damaged_policy_is_refused_in_one_line(residual_run, tmp_path):
     bad = tmp_path / "bad"
     shutil.copytree(residual_run, bad)
     (bad / "policy.npz").write_bytes(b"not a zip")
-    with pytest.raises(RunError, match="not a policy network"):
+    with pytest.raises(RunError, match="expected a policy network"):
         load_run(bad)
     (bad / "policy.npz").unlink()
     shutil.copy(residual_run / "policy.npz", bad / "policy.npz")
     (bad / "actor.json").write_text("[]")
-    with pytest.raises(RunError, match="not a policy's spec"):
+    with pytest.raises(RunError, match="not an object: a policy's spec"):
         load_run(bad)
 
 

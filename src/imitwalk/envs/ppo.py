@@ -111,7 +111,7 @@ def actor_spec(setup: WalkSetup):
     )
 
 
-def _make_env(walk: dict, rank: int):
+def _make_env(walk: dict):
     def make():
         import gymnasium as gym
         from stable_baselines3.common.monitor import Monitor
@@ -182,7 +182,7 @@ def train(
     wall_before = float(before.get("wall_seconds", 0.0))
     kwargs = walk.to_dict()
     kwargs["weights"] = walk.weights
-    makers = [_make_env(kwargs, i) for i in range(cfg.envs)]
+    makers = [_make_env(kwargs)] * cfg.envs
     venv = SubprocVecEnv(makers) if cfg.envs > 1 else DummyVecEnv(makers)
     venv.seed(cfg.seed)
     torch.manual_seed(cfg.seed)

@@ -30,6 +30,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.rl.observation import ACTIONS
 
 __all__ = ["TERMS", "RewardWeights", "TickState", "reward_terms", "total"]
 
@@ -93,7 +94,7 @@ class RewardWeights:
             return cls(
                 pose=0.3, velocity=0.0, end_effector=0.0, com=0.4, alive=0.3, action_rate=0.05
             )
-        raise unknown_name("action", action, ("joints", "residual"), ConfigError)
+        raise unknown_name("action", action, ACTIONS, ConfigError)
 
     @classmethod
     def from_dict(cls, d: dict) -> RewardWeights:

@@ -77,12 +77,11 @@ class ActorSpec:
     @classmethod
     def load(cls, path: str | Path) -> ActorSpec:
         """Read what :meth:`save` wrote (a one-line :class:`RunError` if it cannot)."""
-        path = Path(path)
+        what = "a policy's spec (actor.json of an 'imitwalk rl' run)"
+        keys = ("action", "stand", "weight", "sole_sensors", "previous", "low", "high", "q0")
+        d = readback.read_json(path, what, RunError, required=(*keys, "clock"))
+        readback.check_format(d, ACTOR_FORMAT, str(path), RunError)
         try:
-            d = json.loads(path.read_text())
-            if not isinstance(d, dict):
-                raise TypeError(f"a JSON {type(d).__name__}, not an object")
-            readback.check_format(d, ACTOR_FORMAT, str(path), RunError)
             low, high = np.asarray(d["low"], float), np.asarray(d["high"], float)
             layout = ObservationLayout(
                 stand=np.asarray(d["stand"], float),
@@ -103,11 +102,8 @@ class ActorSpec:
                 int(c["loop_ticks"]),
                 float(c["phase0"]),
             )
-        except FileNotFoundError:
-            where = path.parent
-            raise RunError(f"{path} not found: is {where} a finished 'imitwalk rl' run?") from None
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise RunError(f"{path} is not a policy's spec: {type(exc).__name__}: {exc}") from None
+        except (ValueError, KeyError, TypeError) as exc:
+            raise RunError(f"{path} is not {what}: {type(exc).__name__}: {exc}") from None
         n = len(spec.layout.stand)
         if not (len(low) == len(high) == len(spec.q0) == n) or np.any(high <= low):
             raise RunError(f"{path}: the action box and postures must be {n} joints, low < high")

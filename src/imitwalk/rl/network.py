@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from imitwalk import readback
 from imitwalk.errors import ConfigError, RunError, unknown_name
 from imitwalk.fileio import atomic_write
 
@@ -77,17 +78,17 @@ class MLP:
 
     @classmethod
     def load(cls, path: str | Path) -> MLP:
-        """Read a network :meth:`save` wrote (a one-line :class:`RunError` if it cannot)."""
+        """Read a network :meth:`save` wrote (a one-line :class:`RunError` if it cannot,
+        from :func:`~imitwalk.readback.read_npz`)."""
+        what = "a policy network (policy.npz of an 'imitwalk rl' run)"
+        z = readback.read_npz(path, what, RunError, required=("w0", "b0", "activation"))
+        n = sum(1 for k in z if k.startswith("w"))
         try:
-            with np.load(path, allow_pickle=False) as z:
-                n = sum(1 for k in z.files if k.startswith("w"))
-                weights = tuple(np.asarray(z[f"w{i}"], dtype=float) for i in range(n))
-                biases = tuple(np.asarray(z[f"b{i}"], dtype=float) for i in range(n))
-                act = str(z["activation"])
-        except FileNotFoundError:
-            raise RunError(f"{path} not found: is it a finished 'imitwalk rl' run?") from None
-        except (OSError, ValueError, KeyError) as exc:
-            raise RunError(f"{path} is not a policy network: {type(exc).__name__}: {exc}") from None
+            weights = tuple(np.asarray(z[f"w{i}"], dtype=float) for i in range(n))
+            biases = tuple(np.asarray(z[f"b{i}"], dtype=float) for i in range(n))
+        except (KeyError, ValueError) as exc:
+            raise RunError(f"{path} is not {what}: {type(exc).__name__}: {exc}") from None
+        act = str(z["activation"])
         for i in range(n - 1):
             if weights[i + 1].shape[1] != weights[i].shape[0] or biases[i].shape != (
                 weights[i].shape[0],
