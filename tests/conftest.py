@@ -43,6 +43,11 @@ TICK = [
 ]
 
 
+#: Settings of a tiny stepping run (:mod:`imitwalk.step.learn`): two CMA-ES generations of
+#: four candidates, each on one robot for 3 s.
+TINY_STEP = ["generations=2", "population=4", "robots=1", "seconds=3", "final_robots=1"]
+
+
 def sets(settings: list[str]) -> list[str]:
     """``--set`` arguments for ``settings``."""
     return [a for s in settings for a in ("--set", s)]
@@ -132,4 +137,15 @@ def tick_run(tick_reference, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("tickrun") / "run"
     argv = ["learn", "--reference", str(tick_reference), "--out", str(out), *sets(TICK)]
     assert main(argv) == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def step_run(tmp_path_factory) -> Path:
+    """A finished tiny stepping run (:data:`TINY_STEP`, the default clip) learned through
+    the CLI. Shared: a test that writes into a run copies it first."""
+    from imitwalk.cli.main import main
+
+    out = tmp_path_factory.mktemp("steprun") / "run"
+    assert main(["learn", "--out", str(out), *sets(TINY_STEP)]) == 0
     return out

@@ -359,7 +359,7 @@ def test_cli_mocap_flags(shared_mocap, tmp_path, command):
     mapping = tmp_path / "names.json"
     mapping.write_text(json.dumps({"head": silent["Head"], "neck": silent["Neck"]}))
     argv = [command, str(path), "--up=-x", "--units", "cmu", "--joint-names", str(mapping)]
-    m = _motion(build_parser().parse_args([*argv, "--out", str(tmp_path / "o")]))
+    m = _motion(build_parser().parse_args([*argv, "--out", str(tmp_path / "o")]), robot=None)
     assert (m.meta["up_axis"], m.meta["units"]) == ("-x", "cmu") and not m.meta["up_guessed"]
     assert m.meta["joints"]["head"] == silent["Head"] and m.meta["roles"] == "structure"
     assert_same(m, _reference(str(shared_mocap)), 4, names=(*LOWER_BODY, "head", "neck"))

@@ -63,6 +63,31 @@ def test_the_judge_plays_the_policy_beside_the_stepping_gait(residual_run):
     assert set(out.controllers) == {"rl", "default"} and "rl" in out.comparison
 
 
+def test_an_exported_policy_walks_through_the_runtime_as_the_judge_walks_it(residual_run, tmp_path):
+    """``imitwalk export`` of a residual policy: the runtime, handed only sensor vectors,
+    commands what the judge's policy commands, tick for tick."""
+    from imitwalk.judge.export import export_run
+    from imitwalk.judge.replay import load_run
+    from imitwalk.robots import load_robot
+    from imitwalk.runtime import Controller
+    from imitwalk.sim.mujoco import make_plant, run
+
+    robot = load_robot("hoap2")
+    out = export_run(residual_run, robot, tmp_path / "policy")
+    ctl = Controller.load(out)
+    assert ctl.bundle.kind == "rl-residual"
+    loaded = load_run(residual_run)
+    opts = loaded.step_gait.sim_options()
+    judged = run(make_plant(robot, opts), loaded.policy("rl", robot), 200)
+
+    def policy(k, obs):
+        v = ctl.sensors.vector(obs)
+        return ctl.reset(v) if k == 0 else ctl.step(v)
+
+    mine = run(make_plant(robot, opts), policy, 200, q0=ctl.q0)
+    assert np.array_equal(mine.q_cmd, judged.q_cmd)
+
+
 def test_a_kick_is_walked_with_the_policy(residual_run):
     """Push recovery walks the policy like any controller (one kick, one walk)."""
     from imitwalk.judge.pushes import PushJob, survives

@@ -8,10 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import sets, strip_wall
-
-#: A tiny learning run: one generation of four candidates on one robot, no final choice.
-TINY_STEP = ["generations=2", "population=4", "robots=1", "seconds=3", "final_robots=1"]
+from conftest import TINY_STEP, sets, strip_wall
 
 
 @pytest.fixture(scope="module")

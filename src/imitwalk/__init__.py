@@ -28,6 +28,7 @@ from imitwalk.errors import (
     RetargetError,
     RobotError,
     RunError,
+    SensorError,
 )
 
 __version__ = "0.3.0"
@@ -98,5 +99,6 @@ __all__ = [
     "RetargetError",
     "RobotError",
     "RunError",
+    "SensorError",
     "__version__",
 ]

@@ -46,7 +46,12 @@ class ConfigError(ImitwalkError):
 
 
 class RunError(ImitwalkError):
-    """A run directory is missing, incomplete or incompatible."""
+    """A run directory (or an exported controller) is missing, incomplete or incompatible."""
+
+
+class SensorError(ImitwalkError):
+    """A sensor vector handed to an exported controller has the wrong length or a value
+    that is not finite."""
 
 
 def unknown_name(kind: str, name: str, valid: Iterable[str], cls: type[ImitwalkError] = RobotError):

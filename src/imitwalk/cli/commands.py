@@ -16,12 +16,15 @@ if TYPE_CHECKING:
 __all__ = ["demo", "learn", "playback", "retarget"]
 
 
-def _motion(args: argparse.Namespace):
-    from imitwalk.mocap import default_clip, load_motion
+def _motion(args: argparse.Namespace, robot):
+    """The clip: a mocap file, or ``robot``'s motion from another tool (GMR, LocoMuJoCo)."""
+    from imitwalk.mocap import default_clip
+    from imitwalk.retarget.motionfiles import load_clip
 
     path = args.file or default_clip()
-    return load_motion(
+    return load_clip(
         path,
+        robot,
         skeleton=args.skeleton,
         units=getattr(args, "units", None),
         up=getattr(args, "up", None),
@@ -39,7 +42,7 @@ def retarget(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
     cfg = _with_command(apply_overrides(cfg, args.set), args)
-    motion = _motion(args)
+    motion = _motion(args, robot)
     progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
 
     _announce_search(cfg)
@@ -159,7 +162,7 @@ def learn(args: argparse.Namespace) -> int:
     elif args.reference:
         ref = Reference.load(args.reference)
     else:
-        motion = _motion(args)
+        motion = _motion(args, robot)
         rcfg = _with_command(rcfg, args)
         _announce_search(rcfg)
 
@@ -229,7 +232,7 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
     if args.resume:
         progress(f"learn: resuming {rd.path}")
     else:
-        motion = _motion(args)
+        motion = _motion(args, robot)
         progress(f"learn: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
     progress(
         f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "

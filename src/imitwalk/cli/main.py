@@ -12,7 +12,14 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from imitwalk.cli import commands, judge_commands, rl_commands, robot_commands
+from imitwalk.cli import (
+    commands,
+    export_commands,
+    judge_commands,
+    motion_commands,
+    rl_commands,
+    robot_commands,
+)
 from imitwalk.errors import ImitwalkError
 from imitwalk.judge.protocol import PROTOCOLS
 from imitwalk.sim.types import ENGINES
@@ -41,7 +48,8 @@ def _mocap_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "file",
         nargs="?",
-        help="mocap file (.bvh, .amc, .c3d, DeepMimic .txt); default: pybullet's humanoid3d_walk",
+        help="mocap file (.bvh, .amc, .c3d, DeepMimic .txt) or the robot's motion (GMR .pkl, "
+        "LocoMuJoCo .npz); default: pybullet's humanoid3d_walk",
     )
     p.add_argument("--skeleton", help="the ASF of an AMC file (default: the .asf beside it)")
     p.add_argument("--units", help="BVH length unit: m, cm, mm, inch, cmu (default: detect)")
@@ -220,6 +228,8 @@ def build_parser() -> argparse.ArgumentParser:
     rp.set_defaults(func=judge_commands.report)
 
     rl_commands.add_parser(sub, PROTOCOLS)
+    export_commands.add_parser(sub)
+    motion_commands.add_parser(sub)
 
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")

@@ -144,7 +144,8 @@ class WalkSetup:
 def _base(cfg: WalkConfig, robot: Robot) -> tuple[Motion, StepGait, StepGains]:
     """The clip (a :class:`~imitwalk.mocap.Motion`), its stepping gait and the residual's
     gains: a stepping run's, or the clip's with the shipped gains."""
-    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.mocap import default_clip
+    from imitwalk.retarget.motionfiles import load_clip
     from imitwalk.step.pipeline import gait_from_motion
 
     if cfg.run is not None:
@@ -162,8 +163,8 @@ def _base(cfg: WalkConfig, robot: Robot) -> tuple[Motion, StepGait, StepGains]:
             )
         assert loaded.step_gains is not None
         gait = loaded.step_gait
-        return load_motion(gait.source), gait, loaded.step_gains["learned"]
-    motion = load_motion(cfg.clip or default_clip())
+        return load_clip(gait.source, robot), gait, loaded.step_gains["learned"]
+    motion = load_clip(cfg.clip or default_clip(), robot)
     where = {"robot": cfg.robot, "joint_map": None}  # as a run records its robot
     return motion, gait_from_motion(motion, robot, where), StepGains()
 

@@ -27,6 +27,7 @@ from imitwalk.runs import LearnSummary, RunDir
 
 if TYPE_CHECKING:
     from imitwalk.paper.evaluate import LearnedGait
+    from imitwalk.runtime.bundle import Bundle
     from imitwalk.step.gait import StepGait
 
 __all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
@@ -130,6 +131,35 @@ class LoadedRun:
                 return other
         return controller
 
+    def bundle(self, controller: str, robot, scale: float | None = None) -> Bundle:
+        """A stepping or PPO run's controller ``controller`` at ``scale`` (default: the
+        scale reached) as :mod:`imitwalk.runtime` plays it, and ``imitwalk export``
+        writes it.
+
+        Raises:
+            ConfigError: a controller this run cannot build (listing the ones it can), or
+                a run of another learner (a joint-space reference is not exported).
+        """
+        from imitwalk.runtime.bundle import Bundle
+
+        if self.step_gains is None:
+            raise ConfigError(
+                f"{self.path} is a {self.learner!r} run; export takes stepping and PPO runs "
+                "(learners: step, rl)"
+            )
+        if controller not in self.controllers():
+            raise unknown_name("controller", controller, self.controllers(), ConfigError)
+        scale = self.scale if scale is None else scale
+        source = {"run": self.path, "learner": self.learner, "controller": controller,
+                  "scale": scale}  # fmt: skip
+        if self.actor is not None and controller == "rl":
+            if self.actor[0].layout.action == "joints":
+                return Bundle("rl-joints", robot, self.ref.dt, actor=self.actor, source=source)
+            style, gains = self.step_gait.at_scale(scale), self.step_gains["default"]
+            return Bundle("rl-residual", robot, self.ref.dt, style, gains, self.actor, source)
+        style, gains = self.step_gait.at_scale(scale), self.step_gains[controller]
+        return Bundle("stepping", robot, self.ref.dt, style, gains, source=source)
+
     def policy(self, controller: str, robot, scale: float | None = None, seconds: float = 30.0):
         """A fresh controller ``controller`` (no exploration) at ``scale`` (default: the
         scale reached) for a walk of ``seconds`` [s].
@@ -138,24 +168,10 @@ class LoadedRun:
             ConfigError: a controller this run cannot build (listing the ones it can).
         """
         scale = self.scale if scale is None else scale
-        if self.actor is not None and controller == "rl":
-            from imitwalk.rl.actor import PolicyActor
-            from imitwalk.step.controller import SteppingController
+        if self.step_gains is not None:  # played as exported: through imitwalk.runtime
+            from imitwalk.runtime.controller import Controller
 
-            spec, net = self.actor
-            base = None
-            if spec.layout.action == "residual":
-                assert self.step_gains is not None
-                style = self.step_gait.at_scale(scale)
-                base = SteppingController(robot, style, self.step_gains["default"], self.ref.dt)
-            return PolicyActor(spec, net, base)
-        if self.step_gains is not None:
-            from imitwalk.step.controller import SteppingController
-
-            if controller not in self.step_gains:
-                raise unknown_name("controller", controller, self.controllers(), ConfigError)
-            style = self.step_gait.at_scale(scale)
-            return SteppingController(robot, style, self.step_gains[controller], self.ref.dt)
+            return Controller(self.bundle(controller, robot, scale)).as_policy()
         if controller == OPEN_LOOP:
             return _OpenLoop(self.reference, scale, seconds)
         if controller not in self.controllers():

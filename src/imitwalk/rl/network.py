@@ -3,8 +3,8 @@
 Stable-Baselines3's ``MlpPolicy`` computes its mean action as ``action_net(pi(x))``,
 ``pi`` a stack of linear layers each followed by the activation (tanh by default).
 :class:`MLP` holds those layers' weights and evaluates them with NumPy, so a trained
-policy is judged, replayed and exported without PyTorch. :func:`from_sb3` copies them
-out of a trained model.
+policy is judged, replayed and exported without PyTorch. The trainer copies them out of
+a trained model (:func:`imitwalk.envs.ppo.from_sb3`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from imitwalk import readback
 from imitwalk.errors import ConfigError, RunError, unknown_name
 from imitwalk.fileio import atomic_write
 
-__all__ = ["ACTIVATIONS", "MLP", "from_sb3"]
+__all__ = ["ACTIVATIONS", "MLP"]
 
 
 def _relu(x: np.ndarray) -> np.ndarray:
@@ -95,18 +95,3 @@ class MLP:
             ):
                 raise RunError(f"{path}: layer {i + 1}'s shape does not follow layer {i}'s")
         return cls(weights, biases, act)
-
-
-def from_sb3(model) -> MLP:
-    """The mean-action network of a Stable-Baselines3 ``PPO`` with an ``MlpPolicy`` whose
-    feature extractor is a plain flatten (the default)."""
-    import torch
-
-    pol = model.policy
-    layers = [m for m in pol.mlp_extractor.policy_net if isinstance(m, torch.nn.Linear)]
-    acts = {type(m).__name__ for m in pol.mlp_extractor.policy_net} - {"Linear"}
-    name = {"Tanh": "tanh", "ReLU": "relu"}.get(next(iter(acts), "Tanh"), "tanh")
-    layers.append(pol.action_net)
-    weights = tuple(layer.weight.detach().cpu().numpy().astype(float) for layer in layers)
-    biases = tuple(layer.bias.detach().cpu().numpy().astype(float) for layer in layers)
-    return MLP(weights, biases, name)

@@ -109,6 +109,22 @@ def load_spec(mjcf: Path) -> mujoco.MjSpec:
         raise RobotError(f"{mjcf} is not valid MJCF: {' '.join(str(exc).split())}") from None
 
 
+def _load_binary(mjb: Path, add: Additions) -> mujoco.MjModel:
+    """A model compiled before (``mj_saveModel``, as an export writes it), loaded as it
+    is: what building adds is already in it."""
+    if not add.empty:
+        raise RobotError(f"{mjb} is a compiled model: nothing can be added to it")
+    try:
+        model = mujoco.MjModel.from_binary_path(str(mjb))
+    except (ValueError, mujoco.FatalError) as exc:
+        raise RobotError(
+            f"{mjb} is not a compiled MuJoCo model this MuJoCo ({mujoco.__version__}) "
+            f"reads: {' '.join(str(exc).split())}"
+        ) from None
+    check_model(model, mjb)
+    return model
+
+
 def _compile_spec(spec: mujoco.MjSpec, mjcf: Path) -> mujoco.MjModel:
     try:
         model = spec.compile()
@@ -256,6 +272,7 @@ _MODELS: dict[tuple, mujoco.MjModel] = {}
 
 def compile_model(mjcf: str | Path, add: Additions | None = None) -> mujoco.MjModel:
     """A fresh copy of ``mjcf``'s model with ``add`` added (compiled once per process).
+    A ``.mjb`` file is a model compiled before (an export's) and is loaded as it is.
 
     Raises:
         RobotError: the file is missing, not UTF-8, not valid MJCF, writes a non-finite
@@ -267,6 +284,8 @@ def compile_model(mjcf: str | Path, add: Additions | None = None) -> mujoco.MjMo
     except OSError:
         raise RobotError(f"robot file not found: {mjcf}") from None
     key = (str(mjcf.resolve()), st.st_size, st.st_mtime_ns, add)
+    if key not in _MODELS and mjcf.suffix.lower() == ".mjb":
+        _MODELS[key] = _load_binary(mjcf, add)
     if key not in _MODELS:
         spec = load_spec(mjcf)
         raw = _compile_spec(spec, mjcf)

@@ -118,7 +118,8 @@ def learn(
     run folder ``out``, exactly as ``imitwalk learn CLIP --out OUT`` does.
 
     Args:
-        clip: a :class:`~imitwalk.mocap.Motion`, a mocap file's path, or ``None`` (the
+        clip: a :class:`~imitwalk.mocap.Motion`, a mocap file's or the robot's motion
+            file's path (:func:`~imitwalk.retarget.motionfiles.load_clip`), or ``None`` (the
             embedded walk); robot: a :class:`~imitwalk.robots.Robot` or its name or
             file; cfg: the learning settings (default :class:`StepLearnConfig`);
             resume: continue an interrupted run (its clip and gait are its own);
@@ -126,7 +127,8 @@ def learn(
             ``joint_map``; default: its name).
     """
     from imitwalk.judge.protocol import load_protocol
-    from imitwalk.mocap import Motion, default_clip, load_motion
+    from imitwalk.mocap import Motion, default_clip
+    from imitwalk.retarget.motionfiles import load_clip
     from imitwalk.robots import load_robot
 
     robot = load_robot(robot) if isinstance(robot, str) else robot
@@ -135,7 +137,7 @@ def learn(
     if resume:
         gait = StepGait.load(RunDir(out).file("style.json"))
     else:
-        motion = clip if isinstance(clip, Motion) else load_motion(clip or default_clip())
+        motion = clip if isinstance(clip, Motion) else load_clip(clip or default_clip(), robot)
         gait = gait_from_motion(motion, robot, settings)
         st = gait.style
         if progress is not None:

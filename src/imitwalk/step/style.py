@@ -16,12 +16,15 @@ What the robot adds is its own: the step width (its hips' spacing), the pelvis h
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.params import LegGeometry
-from imitwalk.retarget.template import GaitTemplate
+
+if TYPE_CHECKING:  # the template is read from mocap (SciPy); a style alone needs neither
+    from imitwalk.retarget.template import GaitTemplate
 
 __all__ = ["KNEE_MIN_DEG", "LIFT_MIN", "GaitStyle", "hip_height", "style_from_template"]
 

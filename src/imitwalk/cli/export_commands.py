@@ -1,0 +1,61 @@
+"""``imitwalk export``: a run's controller written for :mod:`imitwalk.runtime`."""
+
+from __future__ import annotations
+
+import argparse
+
+from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import robot_from, run_robot
+
+__all__ = ["add_parser", "export"]
+
+
+def export(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge.export import export_run
+    from imitwalk.runs import RunDir
+    from imitwalk.runtime.bundle import read_manifest
+
+    rd = RunDir(args.run_dir)
+    cfg = rd.read_json("config.json")
+    if args.scale is not None and not 0.0 < args.scale <= 1.5:
+        raise ConfigError(f"--scale {args.scale:g}: expected a stride scale in (0, 1.5]")
+    args.robot, args.joint_map = run_robot(rd, cfg)
+    robot = robot_from(args)
+    out = export_run(rd.path, robot, args.out, args.controller, args.scale)
+    m = read_manifest(out)  # what a robot will read, checked once after writing
+    progress(f"export: {m['controller']} controller of {rd.path} -> {out}")
+    emit(
+        {
+            "out": str(out),
+            "controller": m["controller"],
+            "source": m["source"],
+            "robot": m["robot"],
+            "rate_hz": m["control"]["rate_hz"],
+            "sensors": m["sensors"]["size"],
+            "joints": len(m["joints"]),
+            "files": sorted(m["files"]),
+        },
+        args.json,
+    )
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The ``export`` subcommand's arguments."""
+    p = sub.add_parser(
+        "export",
+        help="write a run's controller as a folder that imitwalk.runtime plays on a robot",
+    )
+    p.add_argument("run_dir", help="a stepping run (learn) or a PPO run (rl)")
+    p.add_argument("--out", required=True, help="the folder to write (replaces an earlier export)")
+    p.add_argument(
+        "--controller",
+        default=None,
+        help="which of the run's controllers (default: learned; rl for a PPO run)",
+    )
+    p.add_argument(
+        "--scale", type=float, default=None, help="the stride scale (default: the one reached)"
+    )
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=export)

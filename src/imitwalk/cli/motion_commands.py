@@ -1,0 +1,84 @@
+"""``imitwalk convert``: a reference or a robot motion written in the field's formats."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import robot_from
+
+__all__ = ["add_parser", "convert"]
+
+#: What ``--to`` writes, and the extension of each.
+TARGETS = {"gmr": ".pkl", "locomujoco": ".npz"}
+
+
+def _is_reference(path: Path) -> bool:
+    """An imitwalk reference ``.npz`` (not a LocoMuJoCo trajectory, which has ``qpos``)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            return "qpos.npy" not in z.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
+def convert(args: argparse.Namespace) -> int:
+    from imitwalk.errors import ConfigError, unknown_name
+    from imitwalk.fileio import check_writable
+    from imitwalk.retarget.motionfiles import read_robot_motion, write_gmr, write_locomujoco
+    from imitwalk.retarget.robotmotion import motion_of_reference
+
+    if args.to not in TARGETS:
+        raise unknown_name("format", args.to, TARGETS, ConfigError)
+    out = Path(args.out)
+    if out.suffix.lower() != TARGETS[args.to]:
+        raise ConfigError(f"--to {args.to} writes a {TARGETS[args.to]} file, not {out.name}")
+    if args.cycles < 1:
+        raise ConfigError(f"--cycles {args.cycles}: expected >= 1")
+    check_writable(out)
+    src = Path(args.source)
+    if src.suffix.lower() == ".npz" and _is_reference(src):
+        from imitwalk.retarget import Reference
+
+        ref = Reference.load(src)
+        if args.robot is None:  # the robot the reference was retargeted to
+            args.robot = ref.settings.get("robot") or ref.robot
+            args.joint_map = args.joint_map or ref.settings.get("joint_map")
+        robot = robot_from(args)
+        motion = motion_of_reference(ref, robot, args.scale, args.cycles)
+    else:
+        args.robot = args.robot or "hoap2"
+        robot = robot_from(args)
+        motion = read_robot_motion(src, robot)
+    (write_gmr if args.to == "gmr" else write_locomujoco)(motion, robot, out)
+    progress(f"convert: {src} -> {out} ({args.to}, {motion.n_frames} frames at {motion.fps:g} Hz)")
+    emit({"out": str(out), "format": args.to, "robot": robot.name, "frames": motion.n_frames,
+          "fps": motion.fps}, args.json)  # fmt: skip
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The ``convert`` subcommand's arguments."""
+    p = sub.add_parser(
+        "convert",
+        help="write a reference (.npz from retarget) or a robot motion as GMR's .pkl or "
+        "LocoMuJoCo's .npz",
+    )
+    p.add_argument("source", help="a reference .npz, a GMR .pkl or a LocoMuJoCo .npz")
+    p.add_argument("--to", required=True, metavar="FORMAT", help="gmr or locomujoco")
+    p.add_argument(
+        "--out", required=True, help="the file to write (.pkl for gmr, .npz for locomujoco)"
+    )
+    p.add_argument("--robot", default=None, help="the robot (default: the reference's; hoap2)")
+    p.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
+    p.add_argument(
+        "--scale", type=float, default=None, help="a reference's stride scale (its largest)"
+    )
+    p.add_argument(
+        "--cycles", type=int, default=4, help="a reference's gait cycles after the start (4)"
+    )
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=convert)
