@@ -19,6 +19,7 @@ from imitwalk.cli import (
     motion_commands,
     rl_commands,
     robot_commands,
+    sweep_commands,
 )
 from imitwalk.errors import ImitwalkError
 from imitwalk.judge.protocol import PROTOCOLS
@@ -230,6 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
     rl_commands.add_parser(sub, PROTOCOLS)
     export_commands.add_parser(sub)
     motion_commands.add_parser(sub)
+    sweep_commands.add_parser(sub)
 
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")
