@@ -190,7 +190,7 @@ class SteppingController:
         self.ankle_zmp = g.ankle * (e.dcm - xi_cmd)
         # the next foot's heading: the heading error turned back, and the turn commanded
         err = self.heading_goal - e.heading
-        self.land_yaw = float(np.clip(g.heading * err, -0.35, 0.35))
+        self.land_yaw = float(min(max(g.heading * err, -0.35), 0.35))
         if self.single:
             self.swing.advance(self.t_phase, self.ss, self.landing, self.land_yaw,
                                e.swing.pos, dt, e.slope)  # fmt: skip
@@ -217,11 +217,11 @@ class SteppingController:
         double support the box spanning both soles."""
         lim = self.half * self.gains.support
         if self.single:
-            return np.clip(p, -lim, lim)
+            return np.minimum(np.maximum(p, -lim), lim)
         other = self.trail.pos[:2]
         lo = np.minimum(-lim, other - lim)
         hi = np.maximum(lim, other + lim)
-        return np.clip(p, lo, hi)
+        return np.minimum(np.maximum(p, lo), hi)
 
     def _joints(self, e: BodyEstimate) -> np.ndarray:
         st, g = self.style, self.gains
@@ -251,7 +251,7 @@ class SteppingController:
         if self.single:
             return {self.stance: 1.0, other: 0.0}
         d = self.trail.pos[:2]
-        w = float(np.clip(np.dot(self.zmp, d) / max(np.dot(d, d), 1e-9), 0.0, 1.0))
+        w = float(min(max(np.dot(self.zmp, d) / max(np.dot(d, d), 1e-9), 0.0), 1.0))
         return {self.stance: 1.0 - w, other: w}
 
     @property

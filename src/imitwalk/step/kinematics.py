@@ -104,6 +104,11 @@ class BodyModel:
                     self.lo[j] = max(self.lo[j], KNEE_FLOOR)
                 else:
                     self.hi[j] = min(self.hi[j], -KNEE_FLOOR)
+        # per leg, what its Newton steps index: columns, dofs, signs, ranges, identity
+        self._leg = {
+            s: (c, self._dadr[c], self._sign[c], self.lo[c], self.hi[c], np.eye(len(c)))
+            for s, c in self.legs.items()
+        }
 
     def _servo_damping(self) -> np.ndarray:
         """``(n,)`` each servo's damping [Nm s/rad]: a position actuator's ``kv``
@@ -196,27 +201,27 @@ class BodyModel:
         Returns:
             ``(n,)`` the posture, clipped to the joint ranges.
         """
-        m, d, r = self.m, self.d, self.robot
+        m, d = self.m, self.d
         q = q.copy()
         targets = {s: (f.pos, rot_z(f.yaw) @ self._flat[s]) for s, f in feet.items()}
-        lo, hi = self.lo, self.hi
         for _ in range(iterations):
             self.set(q, pelvis_mat)
             for s, (pos, mat) in targets.items():
-                cols = self.legs[s]
+                cols, dadr, sign, lo, hi, eye = self._leg[s]
                 sid = self._sole[s]
                 cur = d.site_xmat[sid].reshape(3, 3)
                 err = np.empty(6)
                 err[:3] = pos - d.site_xpos[sid]
                 # orientation error: Σ cur_i × target_i = vee(T Cᵀ − C Tᵀ), halved
                 r = mat @ cur.T
-                err[3:] = 0.5 * np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+                err[3] = 0.5 * (r[2, 1] - r[1, 2])
+                err[4] = 0.5 * (r[0, 2] - r[2, 0])
+                err[5] = 0.5 * (r[1, 0] - r[0, 1])
                 mujoco.mj_jacSite(m, d, self._jacp, self._jacr, sid)
-                jac = np.vstack([self._jacp[:, self._dadr[cols]], self._jacr[:, self._dadr[cols]]])
-                jac = jac * self._sign[cols]
+                jac = np.vstack([self._jacp[:, dadr], self._jacr[:, dadr]]) * sign
                 jt = jac.T
                 lam = damping + 0.1 * float(err @ err)  # Levenberg–Marquardt: damp more when far
-                step = np.linalg.solve(jt @ jac + lam * np.eye(len(cols)), jt @ err)
-                step = np.clip(step, -MAX_STEP, MAX_STEP)
-                q[cols] = np.clip(q[cols] + step, lo[cols], hi[cols])
+                step = np.linalg.solve(jt @ jac + lam * eye, jt @ err)
+                step = np.minimum(np.maximum(step, -MAX_STEP), MAX_STEP)  # np.clip, cheaper
+                q[cols] = np.minimum(np.maximum(q[cols] + step, lo), hi)
         return q
