@@ -17,7 +17,8 @@ needs, and nothing of imitwalk's learning:
 :class:`Bundle` is the same content in memory: the judge builds one from a run folder
 and :func:`read_bundle` one from an export, so both play the controller by the same
 code (:class:`~imitwalk.runtime.controller.Controller`). :func:`write_bundle` writes a
-folder atomically (a reader sees the old export or the new one, never part of one);
+folder atomically (a reader sees the old export or the new one, never part of one; an
+earlier export being replaced is absent for the instant between two renames);
 :func:`read_bundle` refuses one that was tampered with, truncated, or written for
 another format, in one line.
 """
@@ -47,7 +48,16 @@ if TYPE_CHECKING:
     from imitwalk.rl.actor import ActorSpec
     from imitwalk.rl.network import MLP
 
-__all__ = ["BUNDLE_FORMAT", "KINDS", "MANIFEST", "Bundle", "read_bundle", "write_bundle"]
+__all__ = [
+    "BUNDLE_FORMAT",
+    "KINDS",
+    "MANIFEST",
+    "Bundle",
+    "is_export",
+    "read_bundle",
+    "read_manifest",
+    "write_bundle",
+]
 
 #: The format version of an export written here (and the newest read).
 BUNDLE_FORMAT = 1
