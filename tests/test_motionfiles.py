@@ -77,9 +77,9 @@ def test_any_motion_round_trips_exactly(robot, tmp_path_factory, seed, frames):
 
 
 def _qpos(walk, robot):
-    from imitwalk.retarget.motionfiles import _Model
+    from imitwalk.retarget.robotmotion import MotionModel
 
-    return _Model(robot).qpos(walk)
+    return MotionModel(robot).qpos(walk.root_pos, walk.root_quat, walk.joints)
 
 
 def test_a_gmr_file_as_gmr_writes_it_is_read(walk, robot, tmp_path):

@@ -1,15 +1,17 @@
-"""Writing files (pure Python): atomically, so that a reader never sees a half-written
-file, and to paths checked before any work starts."""
+"""Writing files (pure Python; NumPy only for ``.npz``): atomically, so that a reader
+never sees a half-written file, and to paths checked before any work starts."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from imitwalk.errors import ConfigError, ImitwalkError
 
-__all__ = ["atomic_write", "check_writable", "writable_folder"]
+__all__ = ["atomic_write", "check_writable", "writable_folder", "write_npz"]
 
 
 def atomic_write(path: str | Path, write) -> Path:
@@ -28,6 +30,20 @@ def atomic_write(path: str | Path, write) -> Path:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return path
+
+
+def write_npz(path: str | Path, arrays: Mapping[str, Any], compressed: bool = True) -> Path:
+    """Write ``arrays`` (name → array) as an ``.npz`` at ``path``, atomically
+    (:func:`atomic_write`); ``compressed``: ``np.savez_compressed``, else ``np.savez``."""
+    import numpy as np
+
+    save = np.savez_compressed if compressed else np.savez
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:
+            save(fh, **dict(arrays))
+
+    return atomic_write(path, write)
 
 
 def writable_folder(folder: Path) -> bool:

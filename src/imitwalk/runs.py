@@ -15,13 +15,12 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import Any, cast
 
 import numpy as np
 
 from imitwalk import readback
 from imitwalk.errors import RunError
-from imitwalk.fileio import atomic_write, check_writable, writable_folder
+from imitwalk.fileio import atomic_write, check_writable, writable_folder, write_npz
 
 __all__ = ["RUN_FORMAT", "LearnSummary", "RunDir"]
 
@@ -197,12 +196,7 @@ class RunDir:
 
     def write_arrays(self, name: str, arrays: dict[str, np.ndarray]) -> Path:
         """Write a dict of arrays as compressed ``.npz`` atomically."""
-
-        def write(tmp: Path) -> None:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **cast(dict[str, Any], arrays))
-
-        return atomic_write(self.file(name), write)
+        return write_npz(self.file(name), arrays)
 
     def read_arrays(self, name: str) -> dict[str, np.ndarray]:
         """Read an ``.npz`` written by :meth:`write_arrays`."""

@@ -11,10 +11,11 @@ __all__ = ["add_parser", "export"]
 
 
 def export(args: argparse.Namespace) -> int:
+    from imitwalk import readback
     from imitwalk.errors import ConfigError
     from imitwalk.judge.export import export_run
     from imitwalk.runs import RunDir
-    from imitwalk.runtime.bundle import read_manifest
+    from imitwalk.runtime.bundle import MANIFEST
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
@@ -23,7 +24,7 @@ def export(args: argparse.Namespace) -> int:
     args.robot, args.joint_map = run_robot(rd, cfg)
     robot = robot_from(args)
     out = export_run(rd.path, robot, args.out, args.controller, args.scale)
-    m = read_manifest(out)  # what a robot will read, checked once after writing
+    m = readback.read_json(out / MANIFEST, "the export's manifest")
     progress(f"export: {m['controller']} controller of {rd.path} -> {out}")
     emit(
         {

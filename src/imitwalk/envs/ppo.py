@@ -35,13 +35,13 @@ from pathlib import Path
 
 import numpy as np
 
+from imitwalk.envs.sb3net import from_sb3
 from imitwalk.envs.setup import WalkConfig, WalkSetup, build_setup
 from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write
-from imitwalk.rl.network import MLP
 from imitwalk.runs import LearnSummary, RunDir
 
-__all__ = ["LOG_STD_INIT", "PPOConfig", "actor_spec", "from_sb3", "train"]
+__all__ = ["LOG_STD_INIT", "PPOConfig", "actor_spec", "train"]
 
 
 #: The initial exploration noise by action mode [log of the box's half-width]. Residual:
@@ -284,18 +284,3 @@ def train(
 def _save_model(model, tmp: Path) -> None:
     with open(tmp, "wb") as fh:  # a file object: SB3 adds no ".zip" to its name
         model.save(fh)
-
-
-def from_sb3(model) -> MLP:
-    """The mean-action network of a Stable-Baselines3 ``PPO`` with an ``MlpPolicy`` whose
-    feature extractor is a plain flatten (the default)."""
-    import torch
-
-    pol = model.policy
-    layers = [m for m in pol.mlp_extractor.policy_net if isinstance(m, torch.nn.Linear)]
-    acts = {type(m).__name__ for m in pol.mlp_extractor.policy_net} - {"Linear"}
-    name = {"Tanh": "tanh", "ReLU": "relu"}.get(next(iter(acts), "Tanh"), "tanh")
-    layers.append(pol.action_net)
-    weights = tuple(layer.weight.detach().cpu().numpy().astype(float) for layer in layers)
-    biases = tuple(layer.bias.detach().cpu().numpy().astype(float) for layer in layers)
-    return MLP(weights, biases, name)

@@ -28,46 +28,15 @@ import mujoco
 import numpy as np
 
 from imitwalk.errors import MocapError
-from imitwalk.fileio import atomic_write
+from imitwalk.fileio import atomic_write, write_npz
 from imitwalk.mocap import Motion, load_motion
-from imitwalk.retarget.robotmotion import RobotMotion, clip_of_motion
+from imitwalk.retarget.robotmotion import MotionModel, RobotMotion, clip_of_motion
 from imitwalk.robots import Robot
 
 __all__ = ["FORMATS", "load_clip", "read_robot_motion", "write_gmr", "write_locomujoco"]
 
 #: Robot-motion file formats by extension.
 FORMATS = {".pkl": "gmr", ".npz": "locomujoco"}
-
-
-class _Model:
-    """The robot model's joints as qpos columns."""
-
-    def __init__(self, robot: Robot):
-        self.robot = robot
-        self.m = m = robot.compile()
-        free = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
-        if len(free) != 1 or m.jnt_qposadr[free[0]] != 0:
-            raise MocapError(f"robot {robot.name}: a motion file needs one floating base, first")
-        self.names = [
-            mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or "" for j in range(m.njnt)
-        ]
-        self.names[free[0]] = self.names[free[0]] or "root"
-        self.qadr = np.array([m.jnt_qposadr[m.joint(j).id] for j in robot.mj_joints])
-        self.sign = robot.signs.astype(float)
-
-    def qpos(self, motion: RobotMotion) -> np.ndarray:
-        """``(T, nq)`` the model's ``qpos`` of each frame (other joints as standing)."""
-        q = np.tile(self.robot.stand_qpos, (motion.n_frames, 1))
-        q[:, 0:3], q[:, 3:7] = motion.root_pos, motion.root_quat
-        q[:, self.qadr] = motion.joints * self.sign
-        return q
-
-    def motion(self, qpos: np.ndarray, fps: float, source: str) -> RobotMotion:
-        """The inverse of :meth:`qpos`."""
-        quat = qpos[:, 3:7] / np.linalg.norm(qpos[:, 3:7], axis=1, keepdims=True)
-        joints = qpos[:, self.qadr] * self.sign
-        r = self.robot
-        return RobotMotion(r.name, fps, qpos[:, 0:3].copy(), quat, joints, r.joint_names, source)
 
 
 def _check_suffix(path: Path, fmt: str) -> None:
@@ -80,7 +49,7 @@ def write_gmr(motion: RobotMotion, robot: Robot, path: str | Path) -> Path:
     """Write ``motion`` as GMR's robot-motion pickle at ``path`` (atomically)."""
     path = Path(path)
     _check_suffix(path, "gmr")
-    q = _Model(robot).qpos(motion)
+    q = MotionModel(robot).qpos(motion.root_pos, motion.root_quat, motion.joints)
     data = {
         "fps": float(motion.fps),
         "root_pos": q[:, 0:3].copy(),
@@ -97,8 +66,8 @@ def write_locomujoco(motion: RobotMotion, robot: Robot, path: str | Path) -> Pat
     ``qvel`` by finite differences of ``qpos`` (``mj_differentiatePos``)."""
     path = Path(path)
     _check_suffix(path, "locomujoco")
-    mod = _Model(robot)
-    m, q = mod.m, mod.qpos(motion)
+    mod = MotionModel(robot)
+    m, q = mod.m, mod.qpos(motion.root_pos, motion.root_quat, motion.joints)
     dt = 1.0 / motion.fps
     qvel = np.zeros((len(q), m.nv))
     for k in range(len(q) - 1):
@@ -113,12 +82,7 @@ def write_locomujoco(motion: RobotMotion, robot: Robot, path: str | Path) -> Pat
         "njnt": np.array(m.njnt),
         "jnt_type": np.asarray(m.jnt_type).copy(),
     }
-
-    def write(tmp: Path) -> None:
-        with tmp.open("wb") as f:
-            np.savez(f, **arrays)
-
-    return atomic_write(path, write)
+    return write_npz(path, arrays, compressed=False)
 
 
 class _ArraysOnly(pickle.Unpickler):
@@ -151,7 +115,7 @@ def _read_gmr(path: Path, robot: Robot) -> RobotMotion:
     need = ("fps", "root_pos", "root_rot", "dof_pos")
     if not isinstance(data, dict) or any(k not in data for k in need):
         raise MocapError(f"{path} is not a GMR robot-motion file: it needs {', '.join(need)}")
-    mod = _Model(robot)
+    mod = MotionModel(robot)
     try:
         fps = float(data["fps"])
         pos, rot, dof = (np.asarray(data[k], dtype=float) for k in need[1:])
@@ -194,7 +158,7 @@ def _read_locomujoco(path: Path, robot: Robot) -> RobotMotion:
         qpos = qpos[split[0] : split[1]]
     if types[0] != 0:
         raise MocapError(f"{path}: its first joint is not a floating base")
-    mod = _Model(robot)
+    mod = MotionModel(robot)
     missing = [j for j in robot.mj_joints if j not in names]
     if missing:
         raise MocapError(
@@ -203,8 +167,7 @@ def _read_locomujoco(path: Path, robot: Robot) -> RobotMotion:
         )
     q = np.tile(robot.stand_qpos, (len(qpos), 1))
     q[:, 0:7] = qpos[:, 0:7]
-    for j in robot.mj_joints:
-        q[:, mod.m.jnt_qposadr[mod.m.joint(j).id]] = qpos[:, adr[names.index(j)]]
+    q[:, mod.qadr] = qpos[:, [adr[names.index(j)] for j in robot.mj_joints]]
     return mod.motion(q, fps, str(path))
 
 

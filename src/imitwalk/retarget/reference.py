@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from imitwalk.errors import RunError
-from imitwalk.fileio import atomic_write
+from imitwalk.fileio import write_npz
 from imitwalk.readback import FORMAT_KEY
 from imitwalk.retarget.command import GaitCommand, advance
 from imitwalk.retarget.reffile import REFERENCE_FORMAT, read_reference_file
@@ -253,12 +253,7 @@ class Reference:
         arrays["q"] = self.loops[-1]  # the joint trajectory at the largest scale, (N, n)
         meta = {FORMAT_KEY: REFERENCE_FORMAT, **meta}
         arrays["meta_json"] = np.array(json.dumps(meta, default=_jsonable))
-
-        def write(tmp: Path) -> None:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
-
-        return atomic_write(path, write)
+        return write_npz(path, arrays)
 
     @classmethod
     def load(cls, path: str | Path) -> Reference:

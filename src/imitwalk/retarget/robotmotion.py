@@ -28,7 +28,7 @@ from imitwalk.errors import MocapError
 from imitwalk.mocap.motion import Motion
 from imitwalk.robots import Robot
 
-__all__ = ["BALL", "RobotMotion", "clip_of_motion", "motion_of_reference"]
+__all__ = ["BALL", "MotionModel", "RobotMotion", "clip_of_motion", "motion_of_reference"]
 
 #: The ball of the foot (a clip's ``toe``) lies this share of the sole's length ahead of
 #: the sole's centre.
@@ -80,31 +80,52 @@ class RobotMotion:
         return len(self.joints)
 
 
-class _Kinematics:
-    """The robot's model posed frame by frame (kinematics only)."""
+class MotionModel:
+    """The robot's MuJoCo model as a motion sees it: the floating base first in ``qpos``,
+    each role's ``qpos`` column and sign, every joint's name; posed frame by frame for
+    kinematics only (``mj_kinematics``). The motion files
+    (:mod:`imitwalk.retarget.motionfiles`) read and write its ``qpos``.
+
+    Raises:
+        MocapError: the robot has no floating base first in ``qpos``.
+    """
 
     def __init__(self, robot: Robot):
         self.robot = robot
         self.m = m = robot.compile()
         self.d = mujoco.MjData(m)
         free = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
-        if not free:
-            raise MocapError(f"robot {robot.name} has no floating base: it cannot walk a motion")
-        self.free_adr = int(m.jnt_qposadr[free[0]])
+        if len(free) != 1 or m.jnt_qposadr[free[0]] != 0:
+            raise MocapError(f"robot {robot.name}: a motion needs one floating base, first")
         self.root = int(m.jnt_bodyid[free[0]])
+        joint = mujoco.mjtObj.mjOBJ_JOINT
+        self.names = [mujoco.mj_id2name(m, joint, j) or "" for j in range(m.njnt)]
+        self.names[free[0]] = self.names[free[0]] or "root"
         self.qadr = np.array([m.jnt_qposadr[m.joint(j).id] for j in robot.mj_joints])
         self.sign = robot.signs.astype(float)
         self.soles = {s: m.site(robot.soles[s]).id for s in "lr"}
 
+    def qpos(self, root_pos, root_quat, joints) -> np.ndarray:
+        """``(..., nq)`` the model's ``qpos``: the base at ``root_pos`` ``(..., 3)`` and
+        ``root_quat`` ``(..., 4)``, the roles at ``joints`` ``(..., n)`` (the robot's
+        signs), the other joints as when standing."""
+        joints = np.asarray(joints, dtype=float)
+        q = np.broadcast_to(self.robot.stand_qpos, (*joints.shape[:-1], self.m.nq)).copy()
+        q[..., 0:3], q[..., 3:7] = root_pos, root_quat
+        q[..., self.qadr] = joints * self.sign
+        return q
+
+    def motion(self, qpos: np.ndarray, fps: float, source: str) -> RobotMotion:
+        """The motion of ``qpos`` ``(T, nq)`` (the inverse of :meth:`qpos`)."""
+        quat = qpos[:, 3:7] / np.linalg.norm(qpos[:, 3:7], axis=1, keepdims=True)
+        joints = qpos[:, self.qadr] * self.sign
+        r = self.robot
+        return RobotMotion(r.name, fps, qpos[:, 0:3].copy(), quat, joints, r.joint_names, source)
+
     def pose(self, root_pos, root_quat, joints) -> None:
-        """Pose the model: the base at ``root_pos``, ``root_quat``; the roles at ``joints``
-        (the other joints as when standing)."""
-        d = self.d
-        d.qpos[:] = self.robot.stand_qpos
-        d.qpos[self.free_adr : self.free_adr + 3] = root_pos
-        d.qpos[self.free_adr + 3 : self.free_adr + 7] = root_quat
-        d.qpos[self.qadr] = np.asarray(joints) * self.sign
-        mujoco.mj_kinematics(self.m, d)
+        """Pose the model at one frame (:meth:`qpos`)."""
+        self.d.qpos[:] = self.qpos(root_pos, root_quat, joints)
+        mujoco.mj_kinematics(self.m, self.d)
 
     def stand(self) -> None:
         """Pose the model standing (its standing keyframe)."""
@@ -148,7 +169,7 @@ def motion_of_reference(
         down = ref.planned_load(scale, t)[0]
     else:  # the paper's mapping: both feet down in the start-up, the loop's stance after
         down = np.concatenate([np.ones((len(start), 2), bool), *([ref.stance] * cycles)])
-    kin = _Kinematics(robot)
+    kin = MotionModel(robot)
     kin.stand()  # each sole's world frame and height standing: flat on the floor
     flat = {s: kin.sole(s)[1] for s in "lr"}
     height = {s: float(kin.sole(s)[0][2]) for s in "lr"}
@@ -187,7 +208,7 @@ def clip_of_motion(motion: RobotMotion, robot: Robot) -> Motion:
         raise MocapError(f"{motion.source}: a motion of robot {motion.robot!r}, not {robot.name!r}")
     from imitwalk.retarget.ik import leg_geometry
 
-    kin = _Kinematics(robot)
+    kin = MotionModel(robot)
     m, d = kin.m, kin.d
     need = [f"{s}_{r}" for s in "lr" for r in ("hip_pitch", "knee", "ankle_pitch")]
     absent = [r for r in need if r not in robot.joint_names]

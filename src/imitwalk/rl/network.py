@@ -4,7 +4,7 @@ Stable-Baselines3's ``MlpPolicy`` computes its mean action as ``action_net(pi(x)
 ``pi`` a stack of linear layers each followed by the activation (tanh by default).
 :class:`MLP` holds those layers' weights and evaluates them with NumPy, so a trained
 policy is judged, replayed and exported without PyTorch. The trainer copies them out of
-a trained model (:func:`imitwalk.envs.ppo.from_sb3`).
+a trained model (:func:`imitwalk.envs.sb3net.from_sb3`).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 
 from imitwalk import readback
 from imitwalk.errors import ConfigError, RunError, unknown_name
-from imitwalk.fileio import atomic_write
+from imitwalk.fileio import write_npz
 
 __all__ = ["ACTIVATIONS", "MLP"]
 
@@ -69,12 +69,7 @@ class MLP:
         arrays: dict[str, Any] = {f"w{i}": w for i, w in enumerate(self.weights)}
         arrays |= {f"b{i}": b for i, b in enumerate(self.biases)}
         arrays["activation"] = np.array(self.activation)
-
-        def write(tmp: Path) -> None:
-            with open(tmp, "wb") as fh:
-                np.savez(fh, **arrays)
-
-        return atomic_write(path, write)
+        return write_npz(path, arrays, compressed=False)
 
     @classmethod
     def load(cls, path: str | Path) -> MLP:

@@ -34,12 +34,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import mujoco
-import numpy as np
-
 from imitwalk import readback
 from imitwalk.errors import ConfigError, ImitwalkError, RunError, unknown_name
 from imitwalk.robots import Robot
+from imitwalk.robots.saved import MUJOCO_VERSION, ROBOT_FILES, load_saved_robot, save_robot
 from imitwalk.runtime.sensors import BLOCKS, SensorLayout
 from imitwalk.step.gains import StepGains
 from imitwalk.step.style import GaitStyle
@@ -74,7 +72,6 @@ _FRAMES = {
     "foot_force": "normal force of each sole sensor, left sole first, in the order listed",
     "joints": "encoder angle x the joint's sign, in the joint order",
 }
-_ROBOT_FILES = ("robot.json", "robot.mjb")
 _PARTS = {
     "stepping": ("style.json", "gains.json"),
     "rl-residual": ("style.json", "gains.json", "actor.json", "policy.npz"),
@@ -124,60 +121,6 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _finite_or_none(x: np.ndarray) -> list:
-    return [float(v) if np.isfinite(v) else None for v in np.asarray(x, float).ravel()]
-
-
-def _robot_dict(r: Robot) -> dict[str, Any]:
-    return {
-        "name": r.name,
-        "joint_names": list(r.joint_names),
-        "mj_joints": list(r.mj_joints),
-        "signs": r.signs.tolist(),
-        "gyro": r.gyro,
-        "accelerometer": r.accelerometer,
-        "foot_force": {s: list(v) for s, v in r.foot_force.items()},
-        "torso": r.torso,
-        "soles": dict(r.soles),
-        "stand": r.stand.tolist(),
-        "stand_qpos": r.stand_qpos.tolist(),
-        "limits": r.limits.tolist(),
-        "kp": r.kp.tolist(),
-        "torque_limit": _finite_or_none(r.torque_limit),  # None: no limit
-        "total_mass": r.total_mass,
-        "torso_height": r.torso_height,
-        "height": r.height,
-        "sensors": list(r.sensors),
-        "stand_ctrl": None if r.stand_ctrl is None else r.stand_ctrl.tolist(),
-    }
-
-
-def _robot_from(d: dict, mjb: Path) -> Robot:
-    arr = lambda k: np.asarray(d[k], dtype=float)  # noqa: E731
-    return Robot(
-        name=str(d["name"]),
-        mjcf=mjb,
-        joint_names=tuple(map(str, d["joint_names"])),
-        mj_joints=tuple(map(str, d["mj_joints"])),
-        signs=np.asarray(d["signs"], dtype=int),
-        gyro=str(d["gyro"]),
-        accelerometer=None if d["accelerometer"] is None else str(d["accelerometer"]),
-        foot_force={s: tuple(map(str, d["foot_force"][s])) for s in ("l", "r")},
-        torso=str(d["torso"]),
-        soles={s: str(d["soles"][s]) for s in ("l", "r")},
-        stand=arr("stand"),
-        stand_qpos=arr("stand_qpos"),
-        limits=arr("limits").reshape(-1, 2),
-        kp=arr("kp"),
-        torque_limit=np.array([np.inf if v is None else float(v) for v in d["torque_limit"]]),
-        total_mass=float(d["total_mass"]),
-        torso_height=float(d["torso_height"]),
-        height=float(d["height"]),
-        sensors=tuple(map(str, d["sensors"])),
-        stand_ctrl=None if d["stand_ctrl"] is None else arr("stand_ctrl"),
-    )
-
-
 def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
     r, lay = b.robot, b.sensors
     blocks = []
@@ -204,7 +147,7 @@ def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
         readback.FORMAT_KEY: BUNDLE_FORMAT,
         "kind": KIND,
         "controller": b.kind,
-        "versions": {"imitwalk": __version__, "mujoco": mujoco.__version__},
+        "versions": {"imitwalk": __version__, "mujoco": MUJOCO_VERSION},
         "source": b.source,
         "robot": r.name,
         "control": {"rate_hz": 1.0 / b.dt, "dt_s": b.dt},
@@ -218,8 +161,7 @@ def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
 
 def _write_parts(b: Bundle, folder: Path) -> None:
     r = b.robot
-    (folder / "robot.json").write_text(json.dumps(_robot_dict(r), indent=1) + "\n")
-    mujoco.mj_saveModel(r.compile(), str(folder / "robot.mjb"), None)
+    save_robot(r, folder)
     if b.style is not None and b.gains is not None:
         (folder / "style.json").write_text(json.dumps(b.style.to_dict(), indent=1) + "\n")
         (folder / "gains.json").write_text(json.dumps(b.gains.to_dict(), indent=1) + "\n")
@@ -290,7 +232,7 @@ def read_manifest(folder: str | Path) -> dict[str, Any]:
     if kind not in KINDS:
         raise RunError(f"{path}: controller {kind!r} is not one of {', '.join(KINDS)}")
     files = m["files"]
-    need = (*_ROBOT_FILES, *_PARTS[kind])
+    need = (*ROBOT_FILES, *_PARTS[kind])
     if not isinstance(files, dict) or sorted(files) != sorted(need):
         raise RunError(f"{path}: a {kind!r} export lists the files {', '.join(need)}")
     for name in need:
@@ -316,7 +258,7 @@ def read_bundle(folder: str | Path) -> Bundle:
     kind = m["controller"]
     read = lambda name, what: readback.read_json(folder / name, what, RunError)  # noqa: E731
     try:
-        robot = _robot_from(read("robot.json", "a robot record"), folder / "robot.mjb")
+        robot = load_saved_robot(folder)
         dt = float(m["control"]["dt_s"])
         style = gains = actor = None
         if "style.json" in _PARTS[kind]:

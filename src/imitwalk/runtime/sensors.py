@@ -23,6 +23,7 @@ controller reads; :meth:`SensorLayout.vector` is its inverse.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -47,23 +48,27 @@ class SensorLayout:
     sole_sensors: int
     joints: int
 
-    @property
+    @cached_property
     def sizes(self) -> dict[str, int]:
         """Each block's length, in order."""
         return {"gyro": 3, "accel": 3, "foot_force": 2 * self.sole_sensors, "joints": self.joints}
 
-    @property
+    @cached_property
     def size(self) -> int:
         """The vector's length, ``6 + 2 k + n``."""
         return sum(self.sizes.values())
 
-    def slices(self) -> dict[str, slice]:
-        """Each block's slice of the vector."""
+    @cached_property
+    def _slices(self) -> dict[str, slice]:
         out, at = {}, 0
         for name, n in self.sizes.items():
             out[name] = slice(at, at + n)
             at += n
         return out
+
+    def slices(self) -> dict[str, slice]:
+        """Each block's slice of the vector (computed once: a controller asks every tick)."""
+        return dict(self._slices)
 
     def observation(self, sensors, t: float = 0.0) -> Observation:
         """The readings ``sensors`` ``(6 + 2k + n,)`` as an observation at time ``t`` [s].
@@ -84,7 +89,7 @@ class SensorLayout:
             where = ", ".join(self._name_of(int(i)) for i in bad[:4])
             verb = "is" if bad.size == 1 else "are"
             raise SensorError(f"sensors must be finite; {where} {verb} not")
-        s = self.slices()
+        s = self._slices
         return Observation(
             t=float(t),
             gyro=v[s["gyro"]].copy(),
