@@ -19,6 +19,7 @@ NUMPY_ONLY = (
     "config",
     "evidence",
     "evidence.curves",
+    "evidence.navplot",
     "evidence.plots",
     "fileio",
     "judge",
@@ -50,10 +51,12 @@ NUMPY_ONLY = (
     "rl.observation",
     "runs",
     "sim",
+    "sim.fix",
     "sim.metrics",
     "sim.perturb",
     "sim.servo",
     "sim.types",
+    "step.odometry",
 )
 
 

@@ -17,6 +17,7 @@ from imitwalk.cli import (
     export_commands,
     judge_commands,
     motion_commands,
+    navigate_commands,
     rl_commands,
     robot_commands,
     sweep_commands,
@@ -232,6 +233,7 @@ def build_parser() -> argparse.ArgumentParser:
     export_commands.add_parser(sub)
     motion_commands.add_parser(sub)
     sweep_commands.add_parser(sub)
+    navigate_commands.add_parser(sub, PROTOCOLS)
 
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")

@@ -19,7 +19,7 @@ from imitwalk.errors import MocapError
 from imitwalk.mocap.cycles import find_cycles, foot_contacts, heading, heel_strikes
 from imitwalk.mocap.filters import period_frames, smooth
 from imitwalk.mocap.motion import Motion
-from imitwalk.mocap.selection import choose_cycles
+from imitwalk.mocap.selection import MAX_TURN_DEG, choose_cycles
 
 __all__ = ["PHASES", "GaitTemplate", "extract_template"]
 
@@ -71,6 +71,16 @@ class GaitTemplate:
     def speed(self) -> float:
         """Walking speed [m/s]."""
         return self.stride / self.period
+
+    @property
+    def turn_deg(self) -> float:
+        """The heading change per cycle [deg] (+ left): the mean over the cycles averaged
+        (:class:`~imitwalk.mocap.selection.CycleChoice`), or 0 within
+        :data:`~imitwalk.mocap.selection.MAX_TURN_DEG` (a straight walk's wander)."""
+        choice = self.meta.get("cycle_choice")
+        used = [c.turn_deg for c in choice.checks if c.used] if choice is not None else []
+        turn = float(np.mean(used)) if used else 0.0
+        return turn if abs(turn) > MAX_TURN_DEG else 0.0
 
 
 def _unrolled(motion: Motion) -> tuple[dict[str, np.ndarray], int]:

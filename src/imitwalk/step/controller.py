@@ -36,9 +36,10 @@ from imitwalk.step.gains import StepGains
 from imitwalk.step.joints import JointSolver
 from imitwalk.step.kinematics import BodyModel, FootPose, rot_z
 from imitwalk.step.lipm import GRAVITY, dcm_before, lipm_step, omega_of
-from imitwalk.step.nominal import NominalWalk
+from imitwalk.step.nominal import NominalWalk, turning_step
+from imitwalk.step.odometry import LegOdometry, Pose2D, StepCommand
 from imitwalk.step.planner import plan_step
-from imitwalk.step.schedule import LATE, SETTLE, SHIFT
+from imitwalk.step.schedule import LATE, MAX_STEP_YAW, SETTLE, SHIFT
 from imitwalk.step.style import GaitStyle
 from imitwalk.step.swing import SwingFoot
 
@@ -89,7 +90,9 @@ class SteppingController:
         dt: control period [s]; log: keep a :class:`TickLog` per tick (``self.ticks``).
 
     Attributes:
-        q0: the posture it starts from (the robot standing); steps: touchdowns so far.
+        q0: the posture it starts from (the robot standing); steps: touchdowns so far;
+        command: the :class:`~imitwalk.step.odometry.StepCommand` it walks (straight
+        ahead at the style's stride unless :meth:`steer` says otherwise).
     """
 
     def __init__(
@@ -106,7 +109,21 @@ class SteppingController:
         self.nominal = NominalWalk(style, gains, self.omega, self.pelvis_z)
         self.log = log
         self.ticks: list[TickLog] = []
+        self.command = StepCommand(turn=style.turn / 2)
         self._started = False
+
+    def steer(self, command: StepCommand) -> None:
+        """Walk ``command`` from the next tick on (its stride rounded to a twentieth)."""
+        self.command = command
+        self._stride = round(command.stride * 20) / 20
+
+    @property
+    def pose(self) -> Pose2D:
+        """Where the robot is by its own sensors (:mod:`imitwalk.step.odometry`): the
+        centre of mass and the stance sole's heading in the start frame."""
+        if not self._started:
+            return Pose2D(0.0, 0.0, 0.0)
+        return self.odometry.pose(self._com, self._heading)
 
     # -- the tick ------------------------------------------------------------------
     def _start(self, obs) -> None:
@@ -126,14 +143,17 @@ class SteppingController:
         self.zmp, self.ankle_zmp = e.com[:2].copy(), np.zeros(2)
         self.joints.reset(obs.joints)
         self.z0 = float(e.com[2] - self.joints.com_above_pelvis())  # the pelvis over the sole
-        self.heading_goal = 0.0
+        self.odometry = LegOdometry()
+        self.odometry.reset(e.swing.pos[:2], e.heading)
+        self._com, self._heading = e.com[:2].copy(), e.heading
+        self.steer(self.command)
         self._started = True
 
     def _zmp_plan(self, e: BodyEstimate) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         """The planned ZMP now, the heel and toe points, and (in double support) the
         time left before lift-off."""
         side = 1.0 if self.stance == "l" else -1.0
-        gait = self.nominal.gait(self.steps + 1)
+        gait = self.nominal.gait(self.steps + 1, self._stride)
         _, heel, toe = gait.zmp_points(side)
         if self.single:
             s = min(self.t_phase / max(self.ss, 1e-3), 1.0)
@@ -159,11 +179,14 @@ class SteppingController:
             self._start(obs)
         dt, g = self.dt, self.gains
         e = self.est.update(obs, self.zmp)
+        self._com, self._heading = e.com[:2], e.heading
         side = 1.0 if self.stance == "l" else -1.0
-        gait = self.nominal.gait(self.steps + 1)
+        gait = self.nominal.gait(self.steps + 1, self._stride)
         zmp_plan, heel, toe, ds_left = self._zmp_plan(e)
         nominal = np.array([gait.step, -side * gait.width])
-        offset = self.nominal.offset(self.steps + 1, -side)
+        offset = self.nominal.offset(self.steps + 1, -side, self._stride)
+        if self.command.turn:  # a turning gait: the step and its DCM offset turn with it
+            nominal, offset = turning_step(gait.step, gait.width, side, self.command.turn, offset)
         if self.single:
             choice = plan_step(
                 e.dcm, side, gait, self.nominal.limits, self.nominal.weights,
@@ -189,8 +212,11 @@ class SteppingController:
         # ... and the measured DCM's error from it shifts the ZMP through the ankles
         self.ankle_zmp = g.ankle * (e.dcm - xi_cmd)
         # the next foot's heading: the heading error turned back, and the turn commanded
-        err = self.heading_goal - e.heading
-        self.land_yaw = float(min(max(g.heading * err, -0.35), 0.35))
+        err = self.command.heading - e.heading
+        if abs(err) > np.pi:  # the measured heading is wrapped to (-pi, pi]
+            err = (err + np.pi) % (2 * np.pi) - np.pi
+        turn = g.heading * err + (1.0 - g.heading) * self.command.turn  # a turn fed forward
+        self.land_yaw = float(min(max(turn, -MAX_STEP_YAW), MAX_STEP_YAW))
         if self.single:
             self.swing.advance(self.t_phase, self.ss, self.landing, self.land_yaw,
                                e.swing.pos, dt, e.slope)  # fmt: skip
@@ -276,6 +302,9 @@ class SteppingController:
             if self.t_phase >= self.ds_time - 1e-9 and (share <= self.gains.unload or waited):
                 self.single, self.t_phase = True, 0.0
                 self.swing.lift_off(self.trail)
+                if self.command.turn:  # a turning gait: this step lands turned
+                    c = self.command
+                    self.command = StepCommand(c.heading + c.turn, c.stride, c.turn)
             return
         sw = 0 if self.stance == "r" else 1  # the swing sole's column of the loads
         weight = self.fk.mass * GRAVITY
@@ -285,11 +314,14 @@ class SteppingController:
             return
         new = _other(self.stance)
         land = FootPose(e.swing.pos.copy(), e.swing.yaw)
+        self.odometry.touchdown(land.pos[:2], e.heading)
         rot = rot_z(-land.yaw)
         # the old stance foot, seen from the new one
         self.trail = FootPose(rot @ (np.zeros(3) - land.pos), -land.yaw)
         self.trail.pos[2] = 0.0
         r2 = rot[:2, :2]
+        self._com = r2 @ (self._com - land.pos[:2])  # the pose, seen from the new foot
+        self._heading = e.heading + land.yaw
         self.c_ref = r2 @ (self.c_ref - land.pos[:2])
         self.v_ref = r2 @ self.v_ref
         self.joints.rebase(r2)

@@ -15,6 +15,7 @@ from imitwalk.robots import Robot
 from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
 from imitwalk.step.gains import StepGains
+from imitwalk.step.schedule import nominal_track
 from imitwalk.step.style import GaitStyle
 
 __all__ = ["FALL_COST", "StepJob", "StepScore", "score_walk", "walk_step"]
@@ -93,7 +94,11 @@ def walk_step(job: StepJob, log: bool = False):
         opts = replace(opts, control_hz=1.0 / job.dt)
     plant = make_plant(job.robot, opts, job.engine)
     ro = run(plant, ctrl, int(round(job.seconds / job.dt)), abandon=abandoned)
-    m = walk_metrics(ro, job.style.speed * ro.seconds)
+    st = job.style
+    track = None
+    if st.turn:  # a turning gait is judged along its turn
+        track = nominal_track(st.step_length, st.step_time, st.turn / 2, job.dt, ro.seconds)
+    m = walk_metrics(ro, st.speed * ro.seconds, track=track)
     return ctrl, ro, m
 
 

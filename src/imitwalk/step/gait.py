@@ -20,7 +20,7 @@ from imitwalk import readback
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.sim.types import SimOptions
-from imitwalk.step.schedule import START_STEPS, nominal_distance, start_seconds
+from imitwalk.step.schedule import START_STEPS, nominal_distance, nominal_track, start_seconds
 from imitwalk.step.style import GaitStyle
 
 #: The format version ``style.json`` is written in (and the newest :meth:`StepGait.load`
@@ -80,16 +80,17 @@ class StepGait:
 
     def track(self, scale: float, seconds: float) -> np.ndarray:
         """``(T, 3)`` the commanded forward and sideways travel [m] and heading [rad]
-        per control tick (straight ahead)."""
-        steps = max(1, round(seconds / self.dt))
-        out = np.zeros((steps, 3))
-        out[:, 0] = [self.expected_distance(scale, (k + 1) * self.dt) for k in range(steps)]
-        return out
+        per control tick (:func:`~imitwalk.step.schedule.nominal_track`; the heading turns
+        with the style's :attr:`~imitwalk.step.style.GaitStyle.turn`)."""
+        st = self.at_scale(scale)
+        return nominal_track(st.step_length, st.step_time, st.turn / 2, self.dt, seconds)
 
     def ground_path(self, scale: float, seconds: float) -> np.ndarray:
-        """``(T, 2)`` the commanded path on the ground [m] (straight ahead)."""
+        """``(T, 2)`` the commanded path on the ground [m]: the forward travel along the
+        commanded heading."""
         tr = self.track(scale, seconds)
-        return np.stack([tr[:, 0], tr[:, 1]], axis=1)
+        step = np.diff(np.concatenate([[0.0], tr[:, 0]]))
+        return np.stack([np.cumsum(step * np.cos(tr[:, 2])), np.cumsum(step * np.sin(tr[:, 2]))], 1)
 
     def trajectory(self, scale: float, seconds: float) -> None:
         """A stepping gait has no fixed joint trajectory: joints are judged against the

@@ -25,7 +25,7 @@ from imitwalk.step.planner import StepLimits, StepWeights
 from imitwalk.step.schedule import START_STEPS, stride_at
 from imitwalk.step.style import GaitStyle
 
-__all__ = ["NominalWalk"]
+__all__ = ["NominalWalk", "turning_step"]
 
 
 class NominalWalk:
@@ -59,18 +59,19 @@ class NominalWalk:
         self.weights = StepWeights(
             10.0**gains.step_weight, 1.0, 10.0**gains.time_weight, 10.0**gains.zmp_weight
         )
-        self._gaits: dict[int, NominalGait] = {}
-        self._offsets: dict[tuple[int, float], np.ndarray] = {}
+        self._gaits: dict[tuple[int, float], NominalGait] = {}
+        self._offsets: dict[tuple[int, float, float], np.ndarray] = {}
 
-    def gait(self, step: int) -> NominalGait:
+    def gait(self, step: int, stride: float = 1.0) -> NominalGait:
         """The periodic walk step ``step`` (counted from 1) is aimed at: the stride grows
-        over :data:`~imitwalk.step.schedule.START_STEPS` steps."""
-        k = min(step, START_STEPS)
+        over :data:`~imitwalk.step.schedule.START_STEPS` steps to ``stride`` [0, 1] of
+        the style's."""
+        k = (min(step, START_STEPS), stride)
         if k not in self._gaits:
             st, g = self.style, self.gains
             roll = g.zmp_roll * self.half[0]
             self._gaits[k] = NominalGait(
-                step=stride_at(k, st.step_length),
+                step=stride * stride_at(k[0], st.step_length),
                 width=st.step_width,
                 ss=st.single_support,
                 ds=st.double_support,
@@ -81,10 +82,28 @@ class NominalWalk:
             )
         return self._gaits[k]
 
-    def offset(self, step: int, side: float) -> np.ndarray:
+    def offset(self, step: int, side: float, stride: float = 1.0) -> np.ndarray:
         """``(2,)`` the nominal DCM offset at touchdown [m] of step ``step``'s foot landing
-        on ``side`` (+1 left, −1 right)."""
-        key = (min(step, START_STEPS), side)
+        on ``side`` (+1 left, −1 right), at ``stride`` of the style's."""
+        key = (min(step, START_STEPS), side, stride)
         if key not in self._offsets:
-            self._offsets[key] = self.gait(step).offset(side)
+            self._offsets[key] = self.gait(step, stride).offset(side)
         return self._offsets[key]
+
+
+def _rot2(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s], [s, c]])
+
+
+def turning_step(
+    step: float, width: float, side: float, turn: float, offset: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A step of a walk that turns ``turn`` [rad] a step, in the stance foot's frame: where
+    the swing foot lands ``(2,)`` [m] and the nominal DCM offset ``(2,)`` [m] turned with
+    it. The walking frame moves ``step`` [m] along the chord of its arc (half the turn)
+    and turns by ``turn``; each foot sits ``width / 2`` [m] beside it. ``side``: the stance
+    foot's (+1 left); ``offset``: the straight walk's (:meth:`NominalWalk.offset`)."""
+    half = 0.5 * width * side
+    land = _rot2(0.5 * turn) @ np.array([step, 0.0]) + _rot2(turn) @ np.array([0.0, -half])
+    return land - np.array([0.0, half]), _rot2(turn) @ offset

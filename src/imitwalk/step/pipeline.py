@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imitwalk.errors import RunError
+from imitwalk.errors import MocapError, RunError
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.step.gains import StepGains
@@ -35,17 +35,22 @@ __all__ = ["gait_from_motion", "learn", "learn_clip"]
 def gait_from_motion(
     motion, robot: Robot, settings: dict | None = None, dt: float = 0.01
 ) -> StepGait:
-    """The :class:`~imitwalk.step.gait.StepGait` of ``motion`` on ``robot`` at scale 1.
+    """The :class:`~imitwalk.step.gait.StepGait` of ``motion`` on ``robot`` at scale 1:
+    of its straight cycles, or if it has none, of its turning ones (a turning gait, its
+    turn per cycle read from the clip: :attr:`~imitwalk.retarget.template.GaitTemplate.turn_deg`).
 
     Raises:
-        MocapError: the clip holds no straight, steady walking cycle.
+        MocapError: the clip holds no steady walking cycle, straight or turning.
         ConfigError: the robot's legs cannot make the style's step.
     """
     from imitwalk.retarget.ik import leg_geometry
     from imitwalk.retarget.template import extract_template
     from imitwalk.step.style import style_from_template
 
-    template = extract_template(motion)
+    try:
+        template = extract_template(motion)
+    except MocapError:
+        template = extract_template(motion, allow_turn=True)
     style = style_from_template(template, leg_geometry(robot), 1.0)
     return StepGait(
         style=style,
@@ -144,5 +149,17 @@ def learn(
             progress(
                 f"  style: a {st.step_length:.3f} m step every {st.step_time:.2f} s "
                 f"({st.speed:.2f} m/s), {st.step_width:.3f} m wide, {st.clearance:.3f} m high"
+                + _turning(st)
             )
     return learn_clip(gait, robot, cfg, out, protocol, resume=resume, progress=progress)
+
+
+def _turning(style) -> str:
+    """How the style turns, for the learner's progress line ("" for a straight walk)."""
+    if not style.turn:
+        return ""
+    out = f", turning {np.degrees(style.turn):+.1f} deg per cycle"
+    clip = style.human.get("turn_deg", 0.0)
+    if abs(np.degrees(style.turn) - clip) > 0.05:
+        out += f" (the clip's {clip:+.1f} deg, beyond the gait's limit)"
+    return out

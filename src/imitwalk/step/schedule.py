@@ -15,14 +15,21 @@ import numpy as np
 
 __all__ = [
     "LATE",
+    "MAX_STEP_YAW",
     "SETTLE",
     "SHIFT",
     "START_STEPS",
     "nominal_distance",
+    "nominal_track",
     "start_seconds",
     "stride_at",
 ]
 
+#: A step turns the foot by at most this much from the stance foot's heading [rad],
+#: picked by trials on training robots (``eval`` seeds 100-119; pybullet's walker clips
+#: ``turn_left1`` and ``turn_right1``, which turn 55.6° and 53.0° a loop, each held at
+#: :data:`~imitwalk.step.style.MAX_TURN`): 1 of 40 fell at 0.45 rad, 9 of 40 at 0.52.
+MAX_STEP_YAW = 0.45
 #: Steps over which the stride grows from nothing to the style's.
 START_STEPS = 3
 #: Settling from the standing posture to the walking one, and shifting the weight
@@ -56,3 +63,19 @@ def nominal_distance(step_length: float, step_time: float, seconds: float) -> fl
     mid = 0.5 * (feet[1:] + feet[:-1])  # (k + 1,) midpoints after steps 1 … k + 1
     before = 0.0 if k == 0 else mid[k - 1]
     return float(before + (n - k) * (mid[k] - before))
+
+
+def nominal_track(
+    step_length: float, step_time: float, turn: float, dt: float, seconds: float
+) -> np.ndarray:
+    """``(T, 3)`` the nominal schedule's forward travel [m] (:func:`nominal_distance`),
+    sideways travel (none) and heading [rad] at the end of each control tick of ``dt``
+    [s] over ``seconds`` [s], for a walk turning ``turn`` [rad per step] (its heading
+    grows by a step's turn per step time from the first lift-off)."""
+    ticks = max(1, round(seconds / dt))
+    t = (np.arange(ticks) + 1) * dt
+    out = np.zeros((ticks, 3))
+    out[:, 0] = [nominal_distance(step_length, step_time, s) for s in t]
+    if turn:
+        out[:, 2] = turn * np.maximum(t - start_seconds(step_time), 0.0) / step_time
+    return out

@@ -1,0 +1,187 @@
+"""``imitwalk navigate``: a stepping run walks a course of waypoints on a protocol's robots."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from imitwalk.cli.progress import emit, progress
+from imitwalk.cli.robot_args import robot_from, run_robot
+
+__all__ = ["add_parser", "navigate"]
+
+
+def _robot(args: argparse.Namespace, rd, cfg: dict):
+    """The run's robot; ``--robot`` must name the same one."""
+    from imitwalk.errors import ConfigError
+
+    name, joint_map = run_robot(rd, cfg)
+    own = robot_from(argparse.Namespace(robot=name, joint_map=joint_map))
+    if args.robot is None:
+        return own
+    robot = robot_from(args)
+    if robot.name != own.name:
+        raise ConfigError(
+            f"--robot {args.robot}: {rd.path} learned on {own.name!r}, not {robot.name!r}"
+        )
+    return robot
+
+
+def _fix(args: argparse.Namespace):
+    from imitwalk.errors import ConfigError
+    from imitwalk.sim.fix import PositionFix
+
+    if args.fix_rate is None:
+        if args.fix_noise is not None:
+            raise ConfigError("--fix-noise needs --fix-rate HZ (a position fix's rate)")
+        return None
+    return PositionFix(args.fix_rate, 0.05 if args.fix_noise is None else args.fix_noise)
+
+
+def navigate(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from imitwalk.errors import ConfigError
+    from imitwalk.evidence.navplot import course_figure
+    from imitwalk.evidence.plots import png_bytes
+    from imitwalk.fileio import atomic_write
+    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.judge.replay import load_run
+    from imitwalk.navigate.course import DEFAULT_COURSE, Course, parse_waypoints
+    from imitwalk.navigate.trial import NavJob, run_nav_job, walk_course
+    from imitwalk.parallel import run_parallel
+    from imitwalk.runs import RunDir
+
+    wp = np.array(DEFAULT_COURSE) if args.waypoints is None else parse_waypoints(args.waypoints)
+    course = Course(wp, args.reach)
+    if args.seeds < 1 or not args.seconds > 0:
+        raise ConfigError(
+            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
+        )
+    fix = _fix(args)
+    rd = RunDir(args.run_dir)
+    cfg = rd.read_json("config.json")
+    lr = load_run(rd.path)
+    if lr.learner != "step":
+        raise ConfigError(
+            f"{rd.path} is a {lr.learner!r} run; navigate steers the stepping gait (learner: step)"
+        )
+    robot = _robot(args, rd, cfg)
+    out = Path(args.out) if args.out else Path(rd.path) / "navigate"
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out}: exists and is not a folder")
+    gait = lr.step_gait
+    assert lr.step_gains is not None  # a stepping run has its gains
+    style, gains = gait.at_scale(lr.scale), lr.step_gains["learned"]
+    protocol = load_protocol(args.protocol)
+    jobs = [
+        NavJob(
+            robot,
+            style,
+            gains,
+            course,
+            seed,
+            protocol.draw(seed, robot, gait.sim_options(), args.seconds).options,
+            args.seconds,
+            fix,
+            gait.dt,
+        )
+        for seed in range(args.seeds)
+    ]
+    what = "dead reckoning" if fix is None else f"a fix at {fix.rate_hz:g} Hz, {fix.sigma_m:g} m"
+    progress(
+        f"navigate: {len(wp)} waypoints, {args.seeds} robots of {protocol.name}, "
+        f"at most {args.seconds:g} s each, by {what}"
+    )
+    results = run_parallel(run_nav_job, jobs, workers=args.workers)
+    done = [r for r in results if r.finished]
+    summary = {
+        "run": str(rd.path),
+        "robot": robot.name,
+        "protocol": protocol.name,
+        "waypoints": wp.tolist(),
+        "reach_m": course.reach,
+        "fix": None if fix is None else {"rate_hz": fix.rate_hz, "sigma_m": fix.sigma_m},
+        "robots": len(results),
+        "finished": len(done),
+        "fell": sum(r.fell for r in results),
+        "finish_s_mean": float(np.mean([r.finish_s for r in done])) if done else None,
+        "finish_s_max": float(max(r.finish_s for r in done)) if done else None,
+        "closest_m_max": float(max(max(r.closest_m) for r in results)),
+        "odometry_error_m_mean": float(np.mean([r.odometry_error_m for r in results])),
+        "results": [r.to_dict() for r in results],
+    }
+    title = (
+        f"{rd.path}: {len(done)}/{len(results)} robots of {protocol.name} reached all "
+        f"{len(wp)} waypoints"
+    )
+    fig = course_figure(course.waypoints, course.reach, results, title)
+    png = png_bytes(fig)
+    atomic_write(out / "path.png", lambda tmp: tmp.write_bytes(png))
+    if args.video:
+        from imitwalk.sim.render import render_frames, write_mp4
+
+        _, _, ro = walk_course(jobs[0])
+        frames = render_frames(robot, ro.qpos, ro.control_dt, 30.0, distance=2.4, elevation=-50.0)
+        write_mp4(frames, out / "video.mp4", 30.0)  # written beside, then renamed
+        summary["video"] = str(out / "video.mp4")
+    summary["plot"] = str(out / "path.png")
+    text = json.dumps(summary, indent=2)
+    atomic_write(out / "navigate.json", lambda tmp: tmp.write_text(text))
+    progress(f"navigate: {len(done)}/{len(results)} finished, {summary['fell']} fell; -> {out}")
+    emit(summary, args.json)
+    return 0
+
+
+def add_parser(sub, protocols) -> None:
+    """The ``navigate`` subcommand's arguments."""
+    from imitwalk.navigate.course import DEFAULT_COURSE, REACH_M
+
+    p = sub.add_parser(
+        "navigate", help="walk a course of waypoints with a stepping run, steered by odometry"
+    )
+    p.add_argument("run_dir", help="a stepping run (learn)")
+    course = " ".join(f"{x:g},{y:g}" for x, y in DEFAULT_COURSE)
+    p.add_argument(
+        "--waypoints",
+        nargs="*",
+        metavar="X,Y",
+        default=None,
+        help=f"waypoints [m] in the start frame (x ahead, y left; default {course})",
+    )
+    p.add_argument(
+        "--reach",
+        type=float,
+        default=REACH_M,
+        help=f"a waypoint is reached within this [m] ({REACH_M:g})",
+    )
+    p.add_argument(
+        "--protocol",
+        metavar="NAME|FILE",
+        default="eval",
+        help="the robots: " + ", ".join(protocols) + " (default eval), or a protocol .json",
+    )
+    p.add_argument("--seeds", type=int, default=10, help="robots (10)")
+    p.add_argument("--seconds", type=float, default=90.0, help="the most each may take [s] (90)")
+    p.add_argument(
+        "--fix-rate",
+        type=float,
+        default=None,
+        help="a position fix (a camera, a mocap room) this often [Hz]; default none",
+    )
+    p.add_argument(
+        "--fix-noise", type=float, default=None, help="the fix's noise per axis [m] (0.05)"
+    )
+    p.add_argument(
+        "--video",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="render the first robot's walk to video.mp4 (default on)",
+    )
+    p.add_argument("--out", default=None, help="where to write (default RUN/navigate)")
+    p.add_argument("--robot", default=None, help="robot (default: the run's; must be the same)")
+    p.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
+    p.add_argument("--workers", type=int, default=None, help="parallel processes")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=navigate)
