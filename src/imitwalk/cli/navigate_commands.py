@@ -39,6 +39,32 @@ def _fix(args: argparse.Namespace):
     return PositionFix(args.fix_rate, 0.05 if args.fix_noise is None else args.fix_noise)
 
 
+def _video(job, path: Path) -> Path:
+    """``job`` walked again and rendered to ``path`` (written beside, then renamed), the
+    course's waypoints drawn on the floor as discs of its reach."""
+    import numpy as np
+
+    from imitwalk.navigate.trial import walk_course
+    from imitwalk.sim.render import render_frames, write_mp4
+
+    _, _, ro = walk_course(job)
+    w, x, y, z = ro.torso_quat[0]  # the start frame, as the judge takes it
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    turn = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
+    marks = ro.torso_pos[0, :2] + job.course.waypoints @ turn.T
+    frames = render_frames(
+        job.robot,
+        ro.qpos,
+        ro.control_dt,
+        30.0,
+        distance=3.5,
+        elevation=-50.0,
+        markers=marks,
+        marker_radius=job.course.reach,
+    )
+    return write_mp4(frames, path, 30.0)
+
+
 def navigate(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -49,7 +75,7 @@ def navigate(args: argparse.Namespace) -> int:
     from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.replay import load_run
     from imitwalk.navigate.course import DEFAULT_COURSE, Course, parse_waypoints
-    from imitwalk.navigate.trial import NavJob, run_nav_job, walk_course
+    from imitwalk.navigate.trial import NavJob, run_nav_job
     from imitwalk.parallel import run_parallel
     from imitwalk.runs import RunDir
 
@@ -120,12 +146,7 @@ def navigate(args: argparse.Namespace) -> int:
     png = png_bytes(fig)
     atomic_write(out / "path.png", lambda tmp: tmp.write_bytes(png))
     if args.video:
-        from imitwalk.sim.render import render_frames, write_mp4
-
-        _, _, ro = walk_course(jobs[0])
-        frames = render_frames(robot, ro.qpos, ro.control_dt, 30.0, distance=2.4, elevation=-50.0)
-        write_mp4(frames, out / "video.mp4", 30.0)  # written beside, then renamed
-        summary["video"] = str(out / "video.mp4")
+        summary["video"] = str(_video(jobs[0], out / "video.mp4"))
     summary["plot"] = str(out / "path.png")
     text = json.dumps(summary, indent=2)
     atomic_write(out / "navigate.json", lambda tmp: tmp.write_text(text))

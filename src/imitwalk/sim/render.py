@@ -37,6 +37,8 @@ class Renderer:
         width, height: image size [px].
         distance: camera distance, in the robot's standing heights (the camera keeps the
             same framing for a robot of any size); azimuth, elevation: [deg].
+        markers: ``(K, 2)`` points on the floor [m] (world frame) drawn as discs of
+            ``marker_radius`` [m], e.g. a course's waypoints; ``None``: none.
     """
 
     def __init__(
@@ -47,6 +49,8 @@ class Renderer:
         distance: float = 2.3,
         azimuth: float = 120.0,
         elevation: float = -12.0,
+        markers: np.ndarray | None = None,
+        marker_radius: float = 0.05,
     ):
         self.model = m = robot.compile()
         self._look = LOOK_AT * robot.height
@@ -67,6 +71,8 @@ class Renderer:
         scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         self._torso = m.body(robot.torso).id
+        self._markers = np.zeros((0, 2)) if markers is None else np.asarray(markers, float)
+        self._marker_radius = marker_radius
 
     def frame(self, qpos: np.ndarray) -> np.ndarray:
         """One ``(H, W, 3)`` uint8 image of the robot in state ``qpos`` ``(nq,)``."""
@@ -78,7 +84,23 @@ class Renderer:
         self._r.update_scene(self.data, camera=self._cam, scene_option=self._opt)
         self._r.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
         self._r.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
+        self._draw_markers()
         return self._r.render().copy()
+
+    def _draw_markers(self) -> None:
+        scene = self._r.scene
+        for x, y in self._markers:
+            if scene.ngeom >= scene.maxgeom:
+                return
+            mujoco.mjv_initGeom(
+                scene.geoms[scene.ngeom],
+                mujoco.mjtGeom.mjGEOM_CYLINDER,
+                np.array([self._marker_radius, 0.001, 0.0]),
+                np.array([x, y, 0.001]),
+                np.eye(3).ravel(),
+                np.array([0.1, 0.7, 0.2, 0.6], dtype=np.float32),
+            )
+            scene.ngeom += 1
 
     def close(self) -> None:
         """Release the GL context."""
