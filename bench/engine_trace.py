@@ -45,15 +45,21 @@ def main() -> None:
         euler = Rotation.from_quat(ro.torso_quat[:, [1, 2, 3, 0]]).as_euler("xyz", degrees=True)
         soles = ro.foot_force.sum(axis=2)
         for k in range(0, len(ro.t), stride):
-            print(json.dumps({
-                "engine": engine, "t_s": round(float(ro.t[k]), 2),
-                "roll_deg": round(float(euler[k, 0]), 1),
-                "pitch_deg": round(float(euler[k, 1]), 1),
-                "yaw_deg": round(float(euler[k, 2]), 1),
-                "sole_l_n": round(float(soles[k, 0]), 1), "sole_r_n": round(float(soles[k, 1]), 1),
-                "x_m": round(float(ro.torso_pos[k, 0]), 3),
-                "y_m": round(float(ro.torso_pos[k, 1]), 3),
-            }))  # fmt: skip
+            print(
+                json.dumps(
+                    {
+                        "engine": engine,
+                        "t_s": round(float(ro.t[k]), 2),
+                        "roll_deg": round(float(euler[k, 0]), 1),
+                        "pitch_deg": round(float(euler[k, 1]), 1),
+                        "yaw_deg": round(float(euler[k, 2]), 1),
+                        "sole_l_n": round(float(soles[k, 0]), 1),
+                        "sole_r_n": round(float(soles[k, 1]), 1),
+                        "x_m": round(float(ro.torso_pos[k, 0]), 3),
+                        "y_m": round(float(ro.torso_pos[k, 1]), 3),
+                    }
+                )
+            )
         print(json.dumps({"engine": engine, "fell": bool(ro.fell), "fall_time_s": ro.fall_time}))
 
 

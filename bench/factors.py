@@ -48,8 +48,15 @@ def main() -> None:
         "falls": {},
     }
     for name, factors in variants.items():
-        v = judge_protocol(args.run, robot, whole.only(factors), args.seeds, args.seconds,
-                           (args.controller,), first=args.first)  # fmt: skip
+        v = judge_protocol(
+            args.run,
+            robot,
+            whole.only(factors),
+            args.seeds,
+            args.seconds,
+            (args.controller,),
+            first=args.first,
+        )
         side = v.controllers[args.controller]
         out["falls"][name] = side.falls
         print(json.dumps({"variant": name, "falls": side.falls, "robots": side.robots}), flush=True)

@@ -124,12 +124,16 @@ def main() -> None:
             options = [perturbed(s, ref.sim_options()) for s in train_seeds(args.robots)]
         else:
             p = protos[name]
-            options = [p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
-                       for s in range(args.robots)]  # fmt: skip
+            options = [
+                p.draw(args.first + s, robot, ref.sim_options(), args.seconds).options
+                for s in range(args.robots)
+            ]
         for text in args.fractions.split(","):
             off = float(text) * offsets
-            jobs = [(path, args.robot, scale, laws, o, args.seconds, off, args.wait, engine)
-                    for o in options]  # fmt: skip
+            jobs = [
+                (path, args.robot, scale, laws, o, args.seconds, off, args.wait, engine)
+                for o in options
+            ]
             res = run_parallel(_walk, jobs)
             times = sorted(round(t, 2) for f, t, *_ in res if f)
             row = {

@@ -32,8 +32,16 @@ from imitwalk.parallel import run_parallel
 from imitwalk.robots import load_robot
 
 GAINS = (-0.3, -0.15, 0.15, 0.3)
-CHANNELS = ("l_hip_roll", "r_hip_roll", "l_ankle_roll", "r_ankle_roll",
-            "l_hip_pitch", "r_hip_pitch", "l_ankle_pitch", "r_ankle_pitch")  # fmt: skip
+CHANNELS = (
+    "l_hip_roll",
+    "r_hip_roll",
+    "l_ankle_roll",
+    "r_ankle_roll",
+    "l_hip_pitch",
+    "r_hip_pitch",
+    "l_ankle_pitch",
+    "r_ankle_pitch",
+)
 
 
 def swing_law(stance: np.ndarray, k_roll: float, k_pitch: float) -> FeedbackLaw:
@@ -65,8 +73,11 @@ def falls(run, robot, laws, protocol, seeds: int, first: int = 0) -> dict:
         for d in draws
     ]
     res = run_parallel(run_tick_episode, jobs)
-    return {"falls": int(sum(r.fell for r in res)), "robots": len(res),
-            "distance_m": float(np.mean([r.distance_m for r in res]))}  # fmt: skip
+    return {
+        "falls": int(sum(r.fell for r in res)),
+        "robots": len(res),
+        "distance_m": float(np.mean([r.distance_m for r in res])),
+    }
 
 
 def main() -> None:
@@ -93,8 +104,14 @@ def main() -> None:
         out["results"].append(row)
         print(json.dumps(row), file=sys.stderr, flush=True)  # progress
     swept = [r for r in out["results"] if r["law"] != "learned"]
-    best = min(swept, key=lambda r: (r["hard"]["falls"], r[args.factor]["falls"],
-                                     abs(r["k_roll"]) + abs(r["k_pitch"])))  # fmt: skip
+    best = min(
+        swept,
+        key=lambda r: (
+            r["hard"]["falls"],
+            r[args.factor]["falls"],
+            abs(r["k_roll"]) + abs(r["k_pitch"]),
+        ),
+    )
     out["picked"] = {"k_roll": best["k_roll"], "k_pitch": best["k_pitch"]}
     placed = (*base, swing_law(run.ref.stance, best["k_roll"], best["k_pitch"]))
     out["judged"] = {}

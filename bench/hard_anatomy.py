@@ -34,10 +34,19 @@ def walks(run, robot, controller: str, protocol, robots: int, first: int, second
     laws = () if controller == OPEN_LOOP else tuple(run.laws[controller])
     draws = [protocol.draw(first + s, robot, run.ref.sim_options(), seconds) for s in range(robots)]
     jobs = [
-        TickJob(run.path + "/reference.npz", robot, run.scale, laws, d.seed, d.options, seconds,
-                record=False, **run.settings_of(controller))
+        TickJob(
+            run.path + "/reference.npz",
+            robot,
+            run.scale,
+            laws,
+            d.seed,
+            d.options,
+            seconds,
+            record=False,
+            **run.settings_of(controller),
+        )
         for d in draws
-    ]  # fmt: skip
+    ]
     res = run_parallel(run_tick_episode, jobs)
     fell = [(d, r) for d, r in zip(draws, res, strict=True) if r.fell]
     before = [
@@ -66,12 +75,19 @@ def _kicks(draws, res) -> dict:
         survived += [float(np.hypot(k[1], k[2])) for k in due]
         if last is not None:
             t, vx, vy = last
-            fatal.append([round(float(r.fall_time_s - t), 2), round(float(np.hypot(vx, vy)), 2),
-                          round(float(np.degrees(np.arctan2(vy, vx))))])  # fmt: skip
+            fatal.append(
+                [
+                    round(float(r.fall_time_s - t), 2),
+                    round(float(np.hypot(vx, vy)), 2),
+                    round(float(np.degrees(np.arctan2(vy, vx)))),
+                ]
+            )
     if not fatal and not survived:
         return {}
-    return {"fatal_kicks": sorted(fatal, key=lambda k: k[1]),
-            "largest_kick_survived_mps": round(max(survived, default=0.0), 2)}  # fmt: skip
+    return {
+        "fatal_kicks": sorted(fatal, key=lambda k: k[1]),
+        "largest_kick_survived_mps": round(max(survived, default=0.0), 2),
+    }
 
 
 def main() -> None:
@@ -95,8 +111,15 @@ def main() -> None:
         row = walks(run, robot, args.controller, p, args.robots, args.first, args.seconds)
         rows.append(row)
         print(json.dumps(row), flush=True)
-    print(json.dumps({"run": args.run_dir, "controller": args.controller,
-                      "falls": {r["protocol"]: r["falls"] for r in rows}}))  # fmt: skip
+    print(
+        json.dumps(
+            {
+                "run": args.run_dir,
+                "controller": args.controller,
+                "falls": {r["protocol"]: r["falls"] for r in rows},
+            }
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -22,8 +22,11 @@ def measure(path: str, seconds: float) -> dict:
     lr = load_run(path)
     robot = load_robot(lr.ref.settings.get("robot") or "hoap2", lr.ref.settings.get("joint_map"))
     gait, st = lr.ref, lr.ref.style
-    ro = run(make_plant(robot, gait.sim_options()), lr.policy("learned", robot, 1.0, seconds),
-             round(seconds / gait.dt))  # fmt: skip
+    ro = run(
+        make_plant(robot, gait.sim_options()),
+        lr.policy("learned", robot, 1.0, seconds),
+        round(seconds / gait.dt),
+    )
     m = walk_metrics(ro, gait.expected_distance(1.0, ro.seconds))
     timing = gait_timing(
         ro,
@@ -36,13 +39,26 @@ def measure(path: str, seconds: float) -> dict:
     out = {
         "clip": gait.source,
         "fell": m.fell,
-        "human": {"cadence_spm": 120.0 / human["period"], "stride_m": human["stride"],
-                  "speed_mps": human["speed"], "leg_m": human["leg"]},
-        "style": {"cadence_spm": 60.0 / st.step_time, "stride_m": 2 * st.step_length,
-                  "speed_mps": st.speed, "leg_m": st.geometry.leg},
-        "robot": {"cadence_spm": timing.cadence_spm, "stride_m": timing.stride_m,
-                  "speed_mps": speed, "steps": timing.steps, "scuffs": timing.scuffs},
-    }  # fmt: skip
+        "human": {
+            "cadence_spm": 120.0 / human["period"],
+            "stride_m": human["stride"],
+            "speed_mps": human["speed"],
+            "leg_m": human["leg"],
+        },
+        "style": {
+            "cadence_spm": 60.0 / st.step_time,
+            "stride_m": 2 * st.step_length,
+            "speed_mps": st.speed,
+            "leg_m": st.geometry.leg,
+        },
+        "robot": {
+            "cadence_spm": timing.cadence_spm,
+            "stride_m": timing.stride_m,
+            "speed_mps": speed,
+            "steps": timing.steps,
+            "scuffs": timing.scuffs,
+        },
+    }
     rob, sty = out["robot"], out["style"]
     out["ratios"] = {
         k: (None if rob[k] is None else rob[k] / sty[k])

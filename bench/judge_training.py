@@ -32,9 +32,18 @@ def main() -> None:
     out = judge_protocol(a.run, load_robot(a.robot), p, a.robots, 30.0, ("learned",), first=a.first)
     v = out.controllers["learned"]
     fell = [(s.seed, round(s.fall_time_s, 1)) for s in v.per_seed if s.fell]
-    print(json.dumps({"first": a.first, "falls": v.falls, "robots": v.robots, "fell": fell,
-                      "progress_min": round(v.progress_ratio_min, 3),
-                      "distance_m": round(v.distance_m, 3)}))  # fmt: skip
+    print(
+        json.dumps(
+            {
+                "first": a.first,
+                "falls": v.falls,
+                "robots": v.robots,
+                "fell": fell,
+                "progress_min": round(v.progress_ratio_min, 3),
+                "distance_m": round(v.distance_m, 3),
+            }
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -44,14 +44,33 @@ def main() -> None:
     robot = load_robot("hoap2")
     styles = [gait_from_motion(load_motion(c), robot).style for c in args.clips or [default_clip()]]
     names = tuple(n for n in BOUNDS if n != "heading")
-    cfg = StepLearnConfig(robots=args.robots, seconds=args.seconds, generations=args.generations,
-                          population=args.population, sigma=args.sigma, names=names,
-                          final_robots=args.final)  # fmt: skip
+    cfg = StepLearnConfig(
+        robots=args.robots,
+        seconds=args.seconds,
+        generations=args.generations,
+        population=args.population,
+        sigma=args.sigma,
+        names=names,
+        final_robots=args.final,
+    )
     start = StepGains.from_dict(json.loads(open(args.start).read())) if args.start else None
-    res = learn_step(robot, styles, cfg, args.out, load_protocol(cfg.protocol),
-                     resume=args.resume, progress=print, start=start)  # fmt: skip
-    out = {"gains": res.gains.to_dict(), "shipped": StepGains().to_dict(), "final": res.final,
-           "sim_seconds": res.sim_seconds, "wall_seconds": res.wall_seconds}  # fmt: skip
+    res = learn_step(
+        robot,
+        styles,
+        cfg,
+        args.out,
+        load_protocol(cfg.protocol),
+        resume=args.resume,
+        progress=print,
+        start=start,
+    )
+    out = {
+        "gains": res.gains.to_dict(),
+        "shipped": StepGains().to_dict(),
+        "final": res.final,
+        "sim_seconds": res.sim_seconds,
+        "wall_seconds": res.wall_seconds,
+    }
     print(json.dumps(out, indent=2))
 
 

@@ -55,8 +55,18 @@ def main() -> None:
     first = args.runs[0]
     for item in args.runs[1:]:
         rows[item]["vs_first"] = compare_falls(falls[first], falls[item])
-    print(json.dumps({"protocol": args.protocol, "seeds": args.seeds, "first": args.first,
-                      "seconds": args.seconds, "runs": rows}, indent=2))  # fmt: skip
+    print(
+        json.dumps(
+            {
+                "protocol": args.protocol,
+                "seeds": args.seeds,
+                "first": args.first,
+                "seconds": args.seconds,
+                "runs": rows,
+            },
+            indent=2,
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -47,10 +47,14 @@ def main() -> None:
     plan, motion = ref.plan_at(a.scale), ref.motion_at(a.scale)
     p = np.array([[ref.plan_row(plan, motion, k)[s][:3] for s in soles] for k in range(len(ro.t))])
     stride = ref.at_scale(a.scale)[2]
-    out = {"fell": bool(ro.fell), "fall_time_s": ro.fall_time,
-           "distance_m": float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]),
-           "expected_m": ref.expected_distance(a.scale, ro.seconds), "stride_m": stride,
-           "feet": {}}  # fmt: skip
+    out = {
+        "fell": bool(ro.fell),
+        "fall_time_s": ro.fall_time,
+        "distance_m": float(ro.torso_pos[-1, 0] - ro.torso_pos[0, 0]),
+        "expected_m": ref.expected_distance(a.scale, ro.seconds),
+        "stride_m": stride,
+        "feet": {},
+    }
     for j, name in enumerate(soles):
         swing = p[:, j, 2] > 1e-4
         down = ~swing

@@ -50,10 +50,17 @@ def main() -> None:
     for it in range(args.iters):
         r = run(MujocoPlant(robot, opt), lambda k, _o, q=q_cmd: q[k], len(q_ref), q0=q_ref[0])
         err = q_ref[: len(r.q)] - r.q  # (T', n) encoders only
-        print(json.dumps({"iter": it, "fall_s": fall_s(r),
-                          "rms_err_deg": round(float(np.degrees(np.sqrt(np.mean(err**2)))), 2),
-                          "max_err_deg": round(float(np.degrees(np.abs(err).max())), 1)}),
-              flush=True)  # fmt: skip
+        print(
+            json.dumps(
+                {
+                    "iter": it,
+                    "fall_s": fall_s(r),
+                    "rms_err_deg": round(float(np.degrees(np.sqrt(np.mean(err**2)))), 2),
+                    "max_err_deg": round(float(np.degrees(np.abs(err).max())), 1),
+                }
+            ),
+            flush=True,
+        )
         upto = len(err) - (keep if r.fell else 0)
         shifted = np.zeros_like(q_ref)
         if upto > args.lead:

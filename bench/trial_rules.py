@@ -28,9 +28,19 @@ from imitwalk.retarget.reference import Reference
 from imitwalk.robots import load_robot
 
 #: (pitch, roll, heading) gains: the coordinate search's path and its neighbours.
-LAWS = ((0, 0, 0), (0.05, 0, 0), (0.1, 0, 0), (0.2, 0, 0), (0.05, 0.05, 0), (0.1, 0.05, 0),
-        (0.05, 0, -0.25), (0.05, 0, -0.5), (0.1, 0, -0.25), (0.1, 0.05, -0.25),
-        (0.075, 0, -0.25))  # fmt: skip
+LAWS = (
+    (0, 0, 0),
+    (0.05, 0, 0),
+    (0.1, 0, 0),
+    (0.2, 0, 0),
+    (0.05, 0.05, 0),
+    (0.1, 0.05, 0),
+    (0.05, 0, -0.25),
+    (0.05, 0, -0.5),
+    (0.1, 0, -0.25),
+    (0.1, 0.05, -0.25),
+    (0.075, 0, -0.25),
+)
 
 
 def main() -> None:
@@ -77,9 +87,19 @@ def main() -> None:
                 "abs_yaw_deg": float(np.mean([abs(r.yaw_drift_deg) for r in rows])),
             }
         )
-    print(json.dumps({"reference": args.reference, "first": args.first, "robots": args.robots,
-                      "seconds": args.seconds, "protocol": args.protocol, "laws": out},
-                     indent=1))  # fmt: skip
+    print(
+        json.dumps(
+            {
+                "reference": args.reference,
+                "first": args.first,
+                "robots": args.robots,
+                "seconds": args.seconds,
+                "protocol": args.protocol,
+                "laws": out,
+            },
+            indent=1,
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -47,8 +47,13 @@ def test_the_readmes_python_example_runs(tmp_path):
 
 @pytest.mark.slow
 def test_the_readmes_environment_example_runs(tmp_path):
-    out = subprocess.run([sys.executable, "-c", _readme_python()[1]], check=True, cwd=tmp_path,
-                         capture_output=True, text=True)  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-c", _readme_python()[1]],
+        check=True,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
     assert "alive" in out.stdout
 
 
@@ -85,6 +90,7 @@ def test_the_readmes_runtime_loop_walks_an_export(step_run, tmp_path):
 
     assert main(["export", str(step_run), "--out", str(tmp_path / "EXPORT")]) == 0
     code = _ROBOT_IO + _readme_python()[2] + "\nprint(_plant.data.qpos[0])\n"
-    out = subprocess.run([sys.executable, "-c", code], check=True, cwd=tmp_path,
-                         capture_output=True, text=True)  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-c", code], check=True, cwd=tmp_path, capture_output=True, text=True
+    )
     assert float(out.stdout.strip().splitlines()[-1]) > 0.02

@@ -44,9 +44,22 @@ def test_evaluate_judges_every_controller_and_writes_the_protocols_file(run, cap
 
 
 def test_evaluate_explains_the_falls_when_asked(run, capsys):
-    argv = ["evaluate", str(run), "--seconds", "4", "--seeds", "2", "--workers", "1",
-            "--protocol", "hard", "--controllers", "fixed", "--explain-falls",
-            "--json"]  # fmt: skip
+    argv = [
+        "evaluate",
+        str(run),
+        "--seconds",
+        "4",
+        "--seeds",
+        "2",
+        "--workers",
+        "1",
+        "--protocol",
+        "hard",
+        "--controllers",
+        "fixed",
+        "--explain-falls",
+        "--json",
+    ]
     assert main(argv) == 0
     cap = capsys.readouterr()
     side = json.loads(cap.out)["controllers"]["fixed"]

@@ -264,8 +264,13 @@ def test_the_learner_sees_heading_beyond_the_commanded_turn(robot, turning):
     for gz, expected in ((rate, np.zeros(len(tr))), (0.0 * rate, -tr[:, 2])):
         p = TickPolicy(turning, 1.0, (law,), robot.joint_names, 30.0)
         for k in range(len(tr)):
-            obs = Observation(k * dt, np.array([0, 0, gz[k]]), np.array([0, 0, 9.81]),
-                              np.zeros((2, 4)), np.zeros(len(robot.joint_names)))  # fmt: skip
+            obs = Observation(
+                k * dt,
+                np.array([0, 0, gz[k]]),
+                np.array([0, 0, 9.81]),
+                np.zeros((2, 4)),
+                np.zeros(len(robot.joint_names)),
+            )
             p(k, obs)
         np.testing.assert_allclose(p.episode().features[:, h], expected, atol=1e-9)
     assert tr[-1, 2] > np.radians(100)  # it does turn: ~10° per cycle for 30 s
@@ -290,8 +295,17 @@ def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     for mode in ("learned", "feedback", "open_loop"):
         for seed in (0, 1):
             d = protocol.draw(seed, robot, seconds=10.0)
-            job = JudgeJob(str(tmp_path / "run"), robot, mode, seed, d.options, d.furthest,
-                           10.0, None, protocol.engine)  # fmt: skip
+            job = JudgeJob(
+                str(tmp_path / "run"),
+                robot,
+                mode,
+                seed,
+                d.options,
+                d.furthest,
+                10.0,
+                None,
+                protocol.engine,
+            )
             r = run_controller(job).metrics
             assert r.commanded_turn_deg > 20.0  # ~4.8° per cycle for 10 s
             if not r.fell:  # it follows the turn: what is left is a drift, not the turn

@@ -75,8 +75,9 @@ def test_a_reference_without_a_plan_says_so(tiny_reference, robot):
 def _obs(left: float, right: float):
     from imitwalk.sim.types import Observation
 
-    return Observation(0.0, np.zeros(3), np.array([0.0, 0.0, 9.81]),
-                       np.array([[left], [right]]), np.zeros(0))  # fmt: skip
+    return Observation(
+        0.0, np.zeros(3), np.array([0.0, 0.0, 9.81]), np.array([[left], [right]]), np.zeros(0)
+    )
 
 
 def test_the_clock_waits_while_the_lifting_sole_is_loaded(tiny_reference, robot):

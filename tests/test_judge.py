@@ -102,14 +102,28 @@ def test_the_breakdown_counts_each_perturbed_robots_fall_once():
     from imitwalk.sim.metrics import WalkMetrics
 
     def row(seed, fell, furthest):
-        m = WalkMetrics(fell=fell, fall_time_s=1.0 if fell else None, seconds=10.0,
-                        forward_distance_m=1.0, forward_speed_mps=0.1, progress_ratio=0.9,
-                        lateral_drift_m=0.0, yaw_drift_deg=-2.0, gyro_rms=0.1,
-                        max_tilt_deg=1.0, joint_rms_error_rad=0.01)  # fmt: skip
+        m = WalkMetrics(
+            fell=fell,
+            fall_time_s=1.0 if fell else None,
+            seconds=10.0,
+            forward_distance_m=1.0,
+            forward_speed_mps=0.1,
+            progress_ratio=0.9,
+            lateral_drift_m=0.0,
+            yaw_drift_deg=-2.0,
+            gyro_rms=0.1,
+            max_tilt_deg=1.0,
+            joint_rms_error_rad=0.01,
+        )
         return RobotWalk(seed, furthest, m)
 
-    runs = [row(0, True, None), row(1, True, "mass"), row(2, False, "mass"),
-            row(3, True, "slope"), row(4, True, "mass")]  # fmt: skip
+    runs = [
+        row(0, True, None),
+        row(1, True, "mass"),
+        row(2, False, "mass"),
+        row(3, True, "slope"),
+        row(4, True, "mass"),
+    ]
     side = _side(runs, ("mass", "slope", "friction"))
     assert side.falls == 4 and side.survived == 1
     assert side.falls_by_furthest_factor == {"mass": 2, "slope": 1, "friction": 0}
@@ -123,8 +137,16 @@ def test_a_verdict_file_of_another_layout_is_a_one_line_error():
     from imitwalk.errors import RunError
     from imitwalk.judge.records import PushVerdict
 
-    old = {"settings": {"seeds": 40, "seconds": 30.0, "engine": "mujoco", "scale": 1.0,
-                        "channel_gain": 0.5}, "controllers": {}}  # fmt: skip
+    old = {
+        "settings": {
+            "seeds": 40,
+            "seconds": 30.0,
+            "engine": "mujoco",
+            "scale": 1.0,
+            "channel_gain": 0.5,
+        },
+        "controllers": {},
+    }
     with pytest.raises(RunError, match=r"^old\.json: not a protocol verdict of this imitwalk"):
         ProtocolVerdict.from_dict(old, "old.json")
     with pytest.raises(RunError, match=r"^p\.json: not a push-recovery table"):
@@ -135,8 +157,9 @@ def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_ru
     from imitwalk.judge.verdict import JudgeJob, run_controller
 
     protocol = load_protocol("hard")
-    out = judge_protocol(tick_run, robot, protocol, SEEDS, SECONDS, ("fixed",), workers=1,
-                         explain=True)  # fmt: skip
+    out = judge_protocol(
+        tick_run, robot, protocol, SEEDS, SECONDS, ("fixed",), workers=1, explain=True
+    )
     side = out.controllers["fixed"]
     assert side.falls > 0  # hard's robots fall in 6 s on this tiny run
     for r in side.per_seed:
@@ -151,8 +174,9 @@ def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_ru
     for factor in protocol.factors:
         rest = protocol.only([f for f in protocol.factors if f != factor])
         d = rest.draw(seed, robot, seconds=SECONDS)
-        job = JudgeJob(str(tick_run), robot, "fixed", seed, d.options, None, SECONDS, None,
-                       "mujoco")  # fmt: skip
+        job = JudgeJob(
+            str(tick_run), robot, "fixed", seed, d.options, None, SECONDS, None, "mujoco"
+        )
         walk = run_controller(job)
         assert walk.metrics.fell == (factor not in saved[seed]), factor
     back = ProtocolVerdict.from_dict(json.loads(json.dumps(out.to_dict())))
@@ -173,8 +197,10 @@ def test_the_reports_table_lists_the_explained_falls(judged):
     from imitwalk.judge.tables import protocol_table
 
     assert "one factor alone" not in protocol_table(judged)
-    sides = {name: replace(s, falls_saved_by_factor={"pushes": s.falls}, falls_no_single_factor=0)
-             for name, s in judged.controllers.items()}  # fmt: skip
+    sides = {
+        name: replace(s, falls_saved_by_factor={"pushes": s.falls}, falls_no_single_factor=0)
+        for name, s in judged.controllers.items()
+    }
     html = protocol_table(replace(judged, controllers=sides))
     falling = [n for n, s in sides.items() if s.falls]
     assert falling and "one factor alone back to nominal" in html

@@ -24,8 +24,9 @@ def _model(A1, A2, B1, B2) -> PhaseModel:
 
 def _scalar(a: float, b: float, n: int = 1) -> PhaseModel:
     """s_{t+1} = a s_t + b a_t at every one of ``n`` phases."""
-    return _model(np.full((n, 1, 1), a), np.zeros((n, 1, 1)), np.full((n, 1, 1), b),
-                  np.zeros((n, 1, 1)))  # fmt: skip
+    return _model(
+        np.full((n, 1, 1), a), np.zeros((n, 1, 1)), np.full((n, 1, 1), b), np.zeros((n, 1, 1))
+    )
 
 
 def _hand_riccati(a: float, b: float, q: float, r: float, horizon: int) -> float:

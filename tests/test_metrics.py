@@ -16,11 +16,22 @@ def _rollout(torque=None, limit=None, n=100):
     pos = np.c_[np.linspace(0, 0.5, n), np.zeros(n), np.full(n, 0.3)]
     z = np.zeros((n, 3))
     return Rollout(
-        t=np.arange(n) * 0.01, q_cmd=np.zeros((n, 3)), q=np.zeros((n, 3)), gyro=z, accel=z,
-        foot_force=np.zeros((n, 2, 4)), torso_pos=pos, torso_quat=quat, qpos=np.zeros((n, 10)),
-        fell=False, fall_time=None, control_dt=0.01, joint_names=("hip", "knee", "ankle"),
-        torque=torque, torque_limit=limit,
-    )  # fmt: skip
+        t=np.arange(n) * 0.01,
+        q_cmd=np.zeros((n, 3)),
+        q=np.zeros((n, 3)),
+        gyro=z,
+        accel=z,
+        foot_force=np.zeros((n, 2, 4)),
+        torso_pos=pos,
+        torso_quat=quat,
+        qpos=np.zeros((n, 10)),
+        fell=False,
+        fall_time=None,
+        control_dt=0.01,
+        joint_names=("hip", "knee", "ankle"),
+        torque=torque,
+        torque_limit=limit,
+    )
 
 
 @settings(max_examples=30, deadline=None)
@@ -60,10 +71,20 @@ def _stepping(period: float, scuff_at: float | None = None, seconds: float = 12.
     pos[:, 0] = 0.2 * t
     quat = np.tile([1.0, 0.0, 0.0, 0.0], (len(t), 1))
     n = 3
-    return Rollout(t=t, q_cmd=np.zeros((len(t), n)), q=np.zeros((len(t), n)),
-                   gyro=np.zeros((len(t), 3)), accel=np.zeros((len(t), 3)), foot_force=force,
-                   torso_pos=pos, torso_quat=quat, qpos=np.zeros((len(t), 7)), fell=False,
-                   fall_time=None, control_dt=dt)  # fmt: skip
+    return Rollout(
+        t=t,
+        q_cmd=np.zeros((len(t), n)),
+        q=np.zeros((len(t), n)),
+        gyro=np.zeros((len(t), 3)),
+        accel=np.zeros((len(t), 3)),
+        foot_force=force,
+        torso_pos=pos,
+        torso_quat=quat,
+        qpos=np.zeros((len(t), 7)),
+        fell=False,
+        fall_time=None,
+        control_dt=dt,
+    )
 
 
 @given(period=st.floats(0.8, 1.6))

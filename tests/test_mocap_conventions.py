@@ -153,27 +153,97 @@ CMU_NAMES = {
     "LeftHand": "{hand_l}",
 }
 RIGS = {  # a rig's naming convention: part -> name, "{s}" the side in its own spelling
-    "bandai": ("L", "R", dict(pelvis="Hips", hip="UpperLeg_{s}", knee="LowerLeg_{s}",
-                              foot="Foot_{s}", toe="Toes_{s}", clav="Shoulder_{s}",
-                              arm="UpperArm_{s}", fore="LowerArm_{s}", hand="Hand_{s}")),
-    "lafan1": ("Left", "Right", dict(pelvis="Hips", hip="{s}UpLeg", knee="{s}Leg",
-                                     foot="{s}Foot", toe="{s}Toe", clav="{s}Shoulder",
-                                     arm="{s}Arm", fore="{s}ForeArm", hand="{s}Hand")),
-    "l_prefix": ("l", "r", dict(pelvis="pelvis", hip="{s}_thigh", knee="{s}_shin",
-                                foot="{s}_foot", toe="{s}_toes", clav="{s}_clavicle",
-                                arm="{s}_upperarm", fore="{s}_forearm", hand="{s}_hand")),
-    "blender": ("L", "R", dict(pelvis="hips", hip="thigh.{s}", knee="shin.{s}",
-                               foot="foot.{s}", toe="toe.{s}", clav="shoulder.{s}",
-                               arm="upper_arm.{s}", fore="forearm.{s}", hand="hand.{s}")),
-    "unreal": ("l", "r", dict(pelvis="pelvis", hip="thigh_{s}", knee="calf_{s}",
-                              foot="foot_{s}", toe="ball_{s}", clav="clavicle_{s}",
-                              arm="upperarm_{s}", fore="lowerarm_{s}", hand="hand_{s}")),
-    "mixamo": ("Left", "Right", dict(pelvis="mixamorig:Hips", hip="mixamorig:{s}UpLeg",
-                                     knee="mixamorig:{s}Leg", foot="mixamorig:{s}Foot",
-                                     toe="mixamorig:{s}ToeBase", clav="mixamorig:{s}Shoulder",
-                                     arm="mixamorig:{s}Arm", fore="mixamorig:{s}ForeArm",
-                                     hand="mixamorig:{s}Hand")),
-}  # fmt: skip
+    "bandai": (
+        "L",
+        "R",
+        dict(
+            pelvis="Hips",
+            hip="UpperLeg_{s}",
+            knee="LowerLeg_{s}",
+            foot="Foot_{s}",
+            toe="Toes_{s}",
+            clav="Shoulder_{s}",
+            arm="UpperArm_{s}",
+            fore="LowerArm_{s}",
+            hand="Hand_{s}",
+        ),
+    ),
+    "lafan1": (
+        "Left",
+        "Right",
+        dict(
+            pelvis="Hips",
+            hip="{s}UpLeg",
+            knee="{s}Leg",
+            foot="{s}Foot",
+            toe="{s}Toe",
+            clav="{s}Shoulder",
+            arm="{s}Arm",
+            fore="{s}ForeArm",
+            hand="{s}Hand",
+        ),
+    ),
+    "l_prefix": (
+        "l",
+        "r",
+        dict(
+            pelvis="pelvis",
+            hip="{s}_thigh",
+            knee="{s}_shin",
+            foot="{s}_foot",
+            toe="{s}_toes",
+            clav="{s}_clavicle",
+            arm="{s}_upperarm",
+            fore="{s}_forearm",
+            hand="{s}_hand",
+        ),
+    ),
+    "blender": (
+        "L",
+        "R",
+        dict(
+            pelvis="hips",
+            hip="thigh.{s}",
+            knee="shin.{s}",
+            foot="foot.{s}",
+            toe="toe.{s}",
+            clav="shoulder.{s}",
+            arm="upper_arm.{s}",
+            fore="forearm.{s}",
+            hand="hand.{s}",
+        ),
+    ),
+    "unreal": (
+        "l",
+        "r",
+        dict(
+            pelvis="pelvis",
+            hip="thigh_{s}",
+            knee="calf_{s}",
+            foot="foot_{s}",
+            toe="ball_{s}",
+            clav="clavicle_{s}",
+            arm="upperarm_{s}",
+            fore="lowerarm_{s}",
+            hand="hand_{s}",
+        ),
+    ),
+    "mixamo": (
+        "Left",
+        "Right",
+        dict(
+            pelvis="mixamorig:Hips",
+            hip="mixamorig:{s}UpLeg",
+            knee="mixamorig:{s}Leg",
+            foot="mixamorig:{s}Foot",
+            toe="mixamorig:{s}ToeBase",
+            clav="mixamorig:{s}Shoulder",
+            arm="mixamorig:{s}Arm",
+            fore="mixamorig:{s}ForeArm",
+            hand="mixamorig:{s}Hand",
+        ),
+    ),
+}
 
 
 def rig_names(rig: str, prefix: str = "") -> dict[str, str]:
@@ -228,8 +298,9 @@ def test_silent_names_fall_back_on_the_structure(shared_mocap, tmp_path):
     """Names that say nothing: the legs are the two mirror-image chains below the pelvis,
     sided by the direction of travel; the upper body is absent and listed."""
     rig = _rig(str(shared_mocap))
-    path = write_bvh(tmp_path / "v.bvh", rig, rest=rest_along("-z"), step=2, six=True,
-                     names=_silent(rig))  # fmt: skip
+    path = write_bvh(
+        tmp_path / "v.bvh", rig, rest=rest_along("-z"), step=2, six=True, names=_silent(rig)
+    )
     m = load_motion(path)
     assert m.meta["roles"] == "structure" and set(m.keypoints) == set(LOWER_BODY)
     assert len(m.meta["missing_keypoints"]) == 8
@@ -242,9 +313,15 @@ def test_joint_names_file_maps_by_hand(shared_mocap, tmp_path):
     silent = _silent(rig)
     cmu = {"pelvis": "Hips", "neck": "Neck", "head": "Head"}
     for s, side in (("l", "Left"), ("r", "Right")):
-        for key, joint in (("hip", "UpLeg"), ("knee", "Leg"), ("ankle", "Foot"),
-                           ("toe", "ToeBase"), ("shoulder", "Arm"), ("elbow", "ForeArm"),
-                           ("wrist", "Hand")):  # fmt: skip
+        for key, joint in (
+            ("hip", "UpLeg"),
+            ("knee", "Leg"),
+            ("ankle", "Foot"),
+            ("toe", "ToeBase"),
+            ("shoulder", "Arm"),
+            ("elbow", "ForeArm"),
+            ("wrist", "Hand"),
+        ):
             cmu[f"{s}_{key}"] = side + joint
     mapping = tmp_path / "names.json"
     mapping.write_text(json.dumps({k: silent[v] for k, v in cmu.items()}))
@@ -285,8 +362,13 @@ def _standing_tilted(shared_mocap: Path, path: Path) -> Path:
 
 def _no_legs(path: Path) -> Path:
     chain = ["Body", "Neck", "Head"]
-    lines = ["HIERARCHY", "ROOT Body", "{", "OFFSET 0 0 0", "CHANNELS 6 Xposition Yposition "
-             "Zposition Zrotation Yrotation Xrotation"]  # fmt: skip
+    lines = [
+        "HIERARCHY",
+        "ROOT Body",
+        "{",
+        "OFFSET 0 0 0",
+        "CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation",
+    ]
     for name in chain[1:]:
         lines += [f"JOINT {name}", "{", "OFFSET 0 10 0", "CHANNELS 3 Zrotation Yrotation Xrotation"]
     lines += ["End Site", "{", "OFFSET 0 5 0", "}"] + ["}"] * len(chain)

@@ -217,18 +217,51 @@ def test_convert_writes_both_formats_and_refuses_bad_input(tiny_reference, tmp_p
 
     _, ref_path = tiny_reference
     assert main(["convert", str(ref_path), "--to", "gmr", "--out", str(tmp_path / "a.pkl")]) == 0
-    assert main(["convert", str(tmp_path / "a.pkl"), "--to", "locomujoco",
-                 "--out", str(tmp_path / "b.npz")]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "convert",
+                str(tmp_path / "a.pkl"),
+                "--to",
+                "locomujoco",
+                "--out",
+                str(tmp_path / "b.npz"),
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     bad = [
-        (["convert", str(ref_path), "--to", "bvh", "--out", str(tmp_path / "c.bvh")],
-         "valid: gmr, locomujoco"),
+        (
+            ["convert", str(ref_path), "--to", "bvh", "--out", str(tmp_path / "c.bvh")],
+            "valid: gmr, locomujoco",
+        ),
         (["convert", str(ref_path), "--to", "gmr", "--out", str(tmp_path / "c.npz")], ".pkl"),
-        (["convert", str(tmp_path / "none.pkl"), "--to", "gmr", "--out", str(tmp_path / "d.pkl")],
-         "not found"),
-        (["convert", str(ref_path), "--to", "gmr", "--out", str(tmp_path / "e.pkl"),
-          "--cycles", "0"], "--cycles"),
-    ]  # fmt: skip
+        (
+            [
+                "convert",
+                str(tmp_path / "none.pkl"),
+                "--to",
+                "gmr",
+                "--out",
+                str(tmp_path / "d.pkl"),
+            ],
+            "not found",
+        ),
+        (
+            [
+                "convert",
+                str(ref_path),
+                "--to",
+                "gmr",
+                "--out",
+                str(tmp_path / "e.pkl"),
+                "--cycles",
+                "0",
+            ],
+            "--cycles",
+        ),
+    ]
     for argv, word in bad:
         assert main(argv) == 2
         err = capsys.readouterr().err.strip().splitlines()

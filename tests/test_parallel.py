@@ -115,8 +115,12 @@ def test_ctrl_c_cancels_the_jobs_not_started_and_leaves_no_worker(tmp_path, mode
     for delay in (0.0, 0.002, 0.01, 0.05, 0.3):
         folder = tmp_path / f"{delay}"
         folder.mkdir()
-        p = subprocess.Popen([sys.executable, str(script), str(folder), mode],
-                             stdout=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+        p = subprocess.Popen(
+            [sys.executable, str(script), str(folder), mode],
+            stdout=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
         assert p.stdout is not None and p.stdout.readline().strip() == "start"
         time.sleep(delay)
         os.killpg(p.pid, signal.SIGINT)

@@ -73,8 +73,9 @@ def test_the_choice_round_trips_and_counts_its_own_cost():
 
 def test_a_pass_sharing_its_twins_gait_costs_only_its_search():
     first = _verdict(PASSES[0])
-    twin = replace(first, name=PASSES[1], learn_sim_seconds=0.0, learn_wall_seconds=0.0,
-                   same_as=PASSES[0])  # fmt: skip
+    twin = replace(
+        first, name=PASSES[1], learn_sim_seconds=0.0, learn_wall_seconds=0.0, same_as=PASSES[0]
+    )
     c = Choice(pick([first, twin]), (first, twin))
     assert c.kept == PASSES[0] and Choice.from_dict(json.loads(json.dumps(c.to_dict()))) == c
     assert c.cost() == {"learning_sim_seconds": 1300.0, "choice_sim_seconds": 1200 + 640}
@@ -138,19 +139,41 @@ def test_the_search_scores_the_walkers_walks(robot):
     assert "learned law" in rep["method"]
 
 
-QUICK_SEARCH = ["retarget.search_config.generations=1", "retarget.search_config.elites=1",
-                "retarget.search_config.population=2", "retarget.search_config.models=1",
-                "retarget.search_config.seconds=4", "retarget.scales=0.9,1.0"]  # fmt: skip
-QUICK_LEARN = ["start=0.9", "step=0.1", "iterations=1", "robots=2", "seconds=4",
-               "trials.robots=2", "trials.seconds=4", "trials.heading_robots=1",
-               "trials.heading_seconds=4", "choice.robots=2", "choice.seconds=5",
-               "workers=1"]  # fmt: skip
+QUICK_SEARCH = [
+    "retarget.search_config.generations=1",
+    "retarget.search_config.elites=1",
+    "retarget.search_config.population=2",
+    "retarget.search_config.models=1",
+    "retarget.search_config.seconds=4",
+    "retarget.scales=0.9,1.0",
+]
+QUICK_LEARN = [
+    "start=0.9",
+    "step=0.1",
+    "iterations=1",
+    "robots=2",
+    "seconds=4",
+    "trials.robots=2",
+    "trials.seconds=4",
+    "trials.heading_robots=1",
+    "trials.heading_seconds=4",
+    "choice.robots=2",
+    "choice.seconds=5",
+    "workers=1",
+]
 
 
 def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, capsys):
     out = tmp_path / "run"
-    argv = ["learn", "--variant", "extended", "--out", str(out), "--json",
-            *sets([*QUICK_SEARCH, *QUICK_LEARN])]  # fmt: skip
+    argv = [
+        "learn",
+        "--variant",
+        "extended",
+        "--out",
+        str(out),
+        "--json",
+        *sets([*QUICK_SEARCH, *QUICK_LEARN]),
+    ]
     assert main(argv) == 0
     printed = json.loads(capsys.readouterr().out)
     choice = RunDir(out).read_json("choice.json")
@@ -177,14 +200,23 @@ def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, caps
 
 def _no_wall(choice: dict) -> dict:
     walls = ("learn_wall_seconds", "wall_seconds_for_learning")
-    return {**choice, "passes": [{k: v for k, v in p.items() if k not in walls}
-                                 for p in choice["passes"]]}  # fmt: skip
+    return {
+        **choice,
+        "passes": [{k: v for k, v in p.items() if k not in walls} for p in choice["passes"]],
+    }
 
 
 def test_an_interrupted_choice_resumes_to_the_same_choice(tmp_path, capsys):
     out = tmp_path / "run"
-    argv = ["learn", "--variant", "extended", "--out", str(out), "--json",
-            *sets([*QUICK_SEARCH, *QUICK_LEARN])]  # fmt: skip
+    argv = [
+        "learn",
+        "--variant",
+        "extended",
+        "--out",
+        str(out),
+        "--json",
+        *sets([*QUICK_SEARCH, *QUICK_LEARN]),
+    ]
     assert main(argv) == 0
     whole = json.loads(capsys.readouterr().out)["reference_choice"]
     # stopped in pass 2's search, before the choice: pass 1 kept, the rest gone

@@ -310,12 +310,14 @@ def test_export_replaces_an_earlier_export_atomically(step_run, robot, tmp_path,
 def test_bad_export_commands_exit_2_with_one_line(step_run, tick_run, tmp_path, capsys):
     cases = [
         (["export", str(tick_run), "--out", str(tmp_path / "a")], "learners: step, rl"),
-        (["export", str(step_run), "--out", str(tmp_path / "b"), "--controller", "x"],
-         "valid: default, learned"),
+        (
+            ["export", str(step_run), "--out", str(tmp_path / "b"), "--controller", "x"],
+            "valid: default, learned",
+        ),
         (["export", str(step_run), "--out", str(tmp_path / "c"), "--scale", "0"], "--scale"),
         (["export", str(tmp_path / "none"), "--out", str(tmp_path / "d")], "not found"),
         (["export", str(step_run), "--out", str(step_run)], "not an export"),
-    ]  # fmt: skip
+    ]
     for argv, word in cases:
         code, _, err = _cli(argv, capsys)
         lines = err.strip().splitlines()

@@ -83,8 +83,13 @@ def test_import_writes_a_robot_that_cannot_stand_and_says_so(shared_robots, tmp_
     assert len(warnings) == 1 and str(out) in warnings[0] and '"servos"' in warnings[0]
     assert "does NOT stand" in captured.err and out.is_file()
     refused(capsys, ["robot", "stand", out], str(out), "cannot stand")
-    refused(capsys, ["learn", "--robot", out, "--out", tmp_path / "run"], str(out), "cannot stand",
-            left=tmp_path / "run")  # fmt: skip
+    refused(
+        capsys,
+        ["learn", "--robot", out, "--out", tmp_path / "run"],
+        str(out),
+        "cannot stand",
+        left=tmp_path / "run",
+    )
     jm = json.loads(out.read_text())
     jm["servos"] = {"legs": {"kp": 21.1}}  # what the message says to change
     fixed = tmp_path / "fixed.json"  # a new path: robots are cached per process by path

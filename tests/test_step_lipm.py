@@ -44,8 +44,9 @@ def test_dcm_after_matches_a_fine_integration():
 
 
 def test_nominal_offsets_mirror_and_follow_the_periodic_gait():
-    g = NominalGait(step=0.15, width=0.08, ss=0.5, ds=0.13, heel=0.014, toe=0.014, inward=0.0,
-                    omega=6.1)  # fmt: skip
+    g = NominalGait(
+        step=0.15, width=0.08, ss=0.5, ds=0.13, heel=0.014, toe=0.014, inward=0.0, omega=6.1
+    )
     left, right = g.offset(1.0), g.offset(-1.0)
     assert np.isclose(left[0], right[0]) and np.isclose(left[1], -right[1])
     # walking forward, the DCM lands behind the new foot and inside the feet

@@ -7,10 +7,12 @@ import numpy as np
 from imitwalk.step.lipm import NominalGait, dcm_after, dcm_before
 from imitwalk.step.planner import StepLimits, StepWeights, plan_step
 
-GAIT = NominalGait(step=0.15, width=0.078, ss=0.5, ds=0.13, heel=0.014, toe=0.014, inward=0.0,
-                   omega=6.14)  # fmt: skip
-LIMITS = StepLimits(forward=0.19, backward=0.09, inner=0.07, outer=0.16, ss_min=0.25,
-                    ss_max=0.75, swing_speed=1.4)  # fmt: skip
+GAIT = NominalGait(
+    step=0.15, width=0.078, ss=0.5, ds=0.13, heel=0.014, toe=0.014, inward=0.0, omega=6.14
+)
+LIMITS = StepLimits(
+    forward=0.19, backward=0.09, inner=0.07, outer=0.16, ss_min=0.25, ss_max=0.75, swing_speed=1.4
+)
 WEIGHTS = StepWeights(step=10.0, offset=1.0, time=1.0, zmp=0.01)
 BOX = (np.array([-0.02, -0.02]), np.array([0.02, 0.02]))
 
@@ -24,9 +26,14 @@ def _nominal_dcm(elapsed: float) -> np.ndarray:
 
 
 def _plan(xi, now, elapsed, **kw):
-    args = dict(elapsed=elapsed, zmp_now=now, swing_at=np.array([-0.1, 0.078]),
-                nominal_step=np.array([GAIT.step, GAIT.width]), offset=GAIT.offset(1.0),
-                zmp_box=BOX)  # fmt: skip
+    args = dict(
+        elapsed=elapsed,
+        zmp_now=now,
+        swing_at=np.array([-0.1, 0.078]),
+        nominal_step=np.array([GAIT.step, GAIT.width]),
+        offset=GAIT.offset(1.0),
+        zmp_box=BOX,
+    )
     args.update(kw)
     return plan_step(xi, -1.0, GAIT, LIMITS, WEIGHTS, **args)
 

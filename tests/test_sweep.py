@@ -36,8 +36,9 @@ def _longshank(folder: Path) -> Path:
     home = BUILTIN["hoap2"].parent
     xml = (home / "hoap2.xml").read_text()
     for s in "lr":
-        xml = xml.replace(f'<body name="{s}_ankle" pos="0 0 -0.1">',
-                          f'<body name="{s}_ankle" pos="0 0 -0.12">')  # fmt: skip
+        xml = xml.replace(
+            f'<body name="{s}_ankle" pos="0 0 -0.1">', f'<body name="{s}_ankle" pos="0 0 -0.12">'
+        )
     (folder / "longshank.xml").write_text(xml)
     jmap = json.loads((home / "hoap2.json").read_text())
     jmap.update(name="longshank", mjcf="longshank.xml")
@@ -56,8 +57,9 @@ def _cli(argv, capsys):
 def test_a_sweep_learns_judges_and_keeps_its_cells_on_a_rerun(tmp_path, capsys):
     cfg = _sweep(tmp_path, '["default"]', '["hoap2"]')
     out = tmp_path / "out"
-    code, stdout, _ = _cli(["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"],
-                           capsys)  # fmt: skip
+    code, stdout, _ = _cli(
+        ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"], capsys
+    )
     assert code == 0
     res = json.loads(stdout)
     assert (res["cells"], res["ran"], res["kept"], res["refused"]) == (1, 1, 0, 0)
@@ -91,14 +93,19 @@ def test_an_interrupted_two_by_two_sweep_resumes_without_redoing_cells(shared_mo
     done = subprocess.run(argv, capture_output=True, text=True, check=True, timeout=1200)
     res = json.loads(done.stdout)
     assert res["cells"] == 4 and res["kept"] == len(first) and res["ran"] == 4 - len(first)
-    assert {p.parent.name: os.stat(p).st_mtime_ns for p in out.glob("*/row.json")
-            if p.parent.name in first} == first  # fmt: skip
+    assert {
+        p.parent.name: os.stat(p).st_mtime_ns
+        for p in out.glob("*/row.json")
+        if p.parent.name in first
+    } == first
     rows = list(csv.DictReader((out / "results.csv").open()))
     assert len(rows) == 4 and all(r["status"] == "ok" for r in rows)
     assert {(Path(r["clip"]).name, Path(r["robot"]).name) for r in rows} == {
-        ("default", "hoap2"), ("default", "longshank.json"),
-        ("07_04.bvh", "hoap2"), ("07_04.bvh", "longshank.json"),
-    }  # fmt: skip
+        ("default", "hoap2"),
+        ("default", "longshank.json"),
+        ("07_04.bvh", "hoap2"),
+        ("07_04.bvh", "longshank.json"),
+    }
     table = pq.read_table(out / "results.parquet").to_pylist()
     assert [r["cell"] for r in table] == [r["cell"] for r in rows]
 

@@ -51,8 +51,15 @@ def _same_law(a, b) -> None:
 
 def test_a_tiny_run_writes_its_folder(tick_run):
     rd = RunDir(tick_run)
-    for name in ("config.json", "reference.npz", "data.npz", "log.jsonl", "checkpoint.json",
-                 "learned.npz", "metrics.json"):  # fmt: skip
+    for name in (
+        "config.json",
+        "reference.npz",
+        "data.npz",
+        "log.jsonl",
+        "checkpoint.json",
+        "learned.npz",
+        "metrics.json",
+    ):
         assert rd.exists(name), name
     m, cfg = rd.read_json("metrics.json"), _config()
     assert rd.read_json("config.json")["learner"] == m["learner"] == "tick"

@@ -37,8 +37,9 @@ def _learner(falls: dict, monkeypatch, yaw: dict | None = None) -> Learner:
         i = job.seed - first
         fell = bool(falls[job.feedforward][i])
         drift = 0.0 if yaw is None else float(yaw[job.feedforward][i])
-        return TickResult(job.seed, fell, 2.0 if fell else None, 2.0 if fell else 10.0,
-                          1.0, drift, 0.1)  # fmt: skip
+        return TickResult(
+            job.seed, fell, 2.0 if fell else None, 2.0 if fell else 10.0, 1.0, drift, 0.1
+        )
 
     monkeypatch.setattr(ticktrials, "run_tick_episode", walk)
     lr = object.__new__(Learner)
@@ -52,8 +53,19 @@ def _learner(falls: dict, monkeypatch, yaw: dict | None = None) -> Learner:
 def _pick(lr: Learner, state: TickProgress, values, limit=None) -> tuple[float, list]:
     table: list = []
     for v in values:
-        table.append((v, trial(lr, state, "law", [], settings={"feedforward": v},
-                               most=most_falls(table, v, limit))))  # fmt: skip
+        table.append(
+            (
+                v,
+                trial(
+                    lr,
+                    state,
+                    "law",
+                    [],
+                    settings={"feedforward": v},
+                    most=most_falls(table, v, limit),
+                ),
+            )
+        )
     return best(table, limit)[0], table
 
 
@@ -80,8 +92,9 @@ def test_the_cut_keeps_the_full_trials_pick_at_less_cost(rows, limit, descending
         lr = _learner(falls, mp, yaw)
         state = TickProgress()
         kept, table = _pick(lr, state, values, limit)
-        full = [(v, Trial([_walk(f, y) for f, y in zip(falls[v], yaw[v], strict=True)]))
-                for v in values]  # fmt: skip
+        full = [
+            (v, Trial([_walk(f, y) for f, y in zip(falls[v], yaw[v], strict=True)])) for v in values
+        ]
         assert kept == best(full, limit)[0]
         paid = sum(2.0 if f else 10.0 for v in values for f in falls[v])
         assert state.sim_seconds <= paid

@@ -124,11 +124,17 @@ def _whole_learner(run_dir, monkeypatch, say) -> Learner:
     protocol = SimpleNamespace(draw=lambda seed, *_: _Draw(seed))
     monkeypatch.setattr(ticktrials, "load_protocol", lambda _name: protocol)
     lr = object.__new__(Learner)
-    lr.cfg = apply_overrides(TickLearnConfig(), ["workers=1", "trials.robots=3",
-                                                 "trials.heading_robots=2"])  # fmt: skip
+    lr.cfg = apply_overrides(
+        TickLearnConfig(), ["workers=1", "trials.robots=3", "trials.heading_robots=2"]
+    )
     lr.robot, lr.ref_path, lr.scales, lr.say = None, "", (0.3, 0.4, 0.5), say
-    lr.ref = SimpleNamespace(dt=0.01, starts=np.zeros((3, 6)), loops=np.zeros((3, 4)),
-                             plan=True, sim_options=lambda: None)  # fmt: skip
+    lr.ref = SimpleNamespace(
+        dt=0.01,
+        starts=np.zeros((3, 6)),
+        loops=np.zeros((3, 4)),
+        plan=True,
+        sim_options=lambda: None,
+    )
     lr.protocol, lr.rd = protocol, RunDir(run_dir)
     lr.rd.path.mkdir()
     return lr

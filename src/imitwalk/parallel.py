@@ -78,8 +78,9 @@ def run_parallel(
         return _until(jobs, fn, stop)
     ctx = multiprocessing.get_context()
     done = ctx.RawValue("b", 0)
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
-                               initargs=(done,))  # fmt: skip
+    pool = ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(done,)
+    )
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
 

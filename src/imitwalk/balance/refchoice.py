@@ -52,9 +52,15 @@ from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
 
 __all__ = [
-    "PASSES", "Choice", "LawWalker", "PassVerdict", "law_walker", "learn_clip", "pick",
+    "PASSES",
+    "Choice",
+    "LawWalker",
+    "PassVerdict",
+    "law_walker",
+    "learn_clip",
+    "pick",
     "same_gait",
-]  # fmt: skip
+]
 
 #: The two passes, in the order they run (a tie keeps the first).
 PASSES = ("searched", "closed")
@@ -74,9 +80,19 @@ class LawWalker:
     def __call__(
         self, ref, robot: Robot, scale: float, seed: int, options: SimOptions, seconds: float
     ) -> WalkMetrics:
-        job = TickJob("", robot, scale, (self.law,), seed, options, seconds,
-                      engine=self.engine, record=False, feedforward=self.feedforward,
-                      wait=self.wait)  # fmt: skip
+        job = TickJob(
+            "",
+            robot,
+            scale,
+            (self.law,),
+            seed,
+            options,
+            seconds,
+            engine=self.engine,
+            record=False,
+            feedforward=self.feedforward,
+            wait=self.wait,
+        )
         return tick_walk_metrics(job, ref)
 
 
@@ -161,9 +177,13 @@ def pick(verdicts: list[PassVerdict]) -> str:
 
 
 def learn_clip(
-    make_reference, robot: Robot, cfg: TickLearnConfig, run_dir, resume: bool = False,
+    make_reference,
+    robot: Robot,
+    cfg: TickLearnConfig,
+    run_dir,
+    resume: bool = False,
     progress=None,
-) -> tuple[LearnSummary, Choice]:  # fmt: skip
+) -> tuple[LearnSummary, Choice]:
     """Learn the two passes (module docstring) into ``run_dir`` and keep the better.
 
     Args:
@@ -231,15 +251,22 @@ def same_gait(a, b) -> bool:
     return (
         a.params == b.params
         and a.scale_params == b.scale_params
-        and all(np.array_equal(getattr(a, k), getattr(b, k))
-                for k in ("scales", "loops", "starts", "start_travel"))
-    )  # fmt: skip
+        and all(
+            np.array_equal(getattr(a, k), getattr(b, k))
+            for k in ("scales", "loops", "starts", "start_travel")
+        )
+    )
 
 
 def _judge(
-    root: RunDir, robot: Robot, cfg: TickLearnConfig, summaries: dict, searched: dict,
-    same: dict, say,
-) -> Choice:  # fmt: skip
+    root: RunDir,
+    robot: Robot,
+    cfg: TickLearnConfig,
+    summaries: dict,
+    searched: dict,
+    same: dict,
+    say,
+) -> Choice:
     """Each pass's learned controller on the choice's training robots; ``searched``: each
     pass's reference search's simulated seconds [s]; ``same``: the passes that share an
     earlier pass's gait, and whose."""
@@ -253,27 +280,54 @@ def _judge(
     for name in PASSES:
         if name in same:  # its twin's verdict, walked once
             twin = next(v for v in out if v.name == same[name])
-            out.append(replace(twin, name=name, learn_sim_seconds=0.0, learn_wall_seconds=0.0,
-                               search_sim_seconds=searched[name], same_as=twin.name))  # fmt: skip
+            out.append(
+                replace(
+                    twin,
+                    name=name,
+                    learn_sim_seconds=0.0,
+                    learn_wall_seconds=0.0,
+                    search_sim_seconds=searched[name],
+                    same_as=twin.name,
+                )
+            )
             say(f"  {name}: {twin.name}'s gait, {twin.name}'s verdict")
             continue
         path, s = root.file(name), summaries[name]
         # at pass 1's scale, a pass that has fallen more often can no longer be kept
         tie = out and s.scale_reached == out[0].scale
-        v = judge_protocol(path, robot, protocol, c.robots, c.seconds, ("learned",),
-                           workers=cfg.workers, first=c.first,
-                           most_falls=out[0].falls if tie else None)  # fmt: skip
+        v = judge_protocol(
+            path,
+            robot,
+            protocol,
+            c.robots,
+            c.seconds,
+            ("learned",),
+            workers=cfg.workers,
+            first=c.first,
+            most_falls=out[0].falls if tie else None,
+        )
         cv = v.controllers["learned"]
         walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
-        out.append(PassVerdict(
-            name, float(s.scale_reached), cv.falls, cv.robots,
-            float(cv.progress_ratio_min or 0.0), float(cv.distance_m or 0.0), float(walked),
-            s.sim_seconds_used_for_learning, s.wall_seconds_for_learning,
-            searched[name],
-        ))  # fmt: skip
+        out.append(
+            PassVerdict(
+                name,
+                float(s.scale_reached),
+                cv.falls,
+                cv.robots,
+                float(cv.progress_ratio_min or 0.0),
+                float(cv.distance_m or 0.0),
+                float(walked),
+                s.sim_seconds_used_for_learning,
+                s.wall_seconds_for_learning,
+                searched[name],
+            )
+        )
         cut = f" (stopped: more falls than {PASSES[0]})" if cv.robots < c.robots else ""
-        how = (f"walked {walked / cv.robots:.1f} s on average" if cv.falls == cv.robots
-               else f"slowest progress {cv.progress_ratio_min or 0.0:.2f}")  # fmt: skip
+        how = (
+            f"walked {walked / cv.robots:.1f} s on average"
+            if cv.falls == cv.robots
+            else f"slowest progress {cv.progress_ratio_min or 0.0:.2f}"
+        )
         say(f"  {name}: {cv.falls} of {cv.robots} fell, {how}{cut}")
     kept = pick(out)
     say(f"learn: keeping pass {kept}")
@@ -285,8 +339,10 @@ def _keep(root: RunDir, name: str) -> None:
     no hard links), ``metrics.json`` last. Every run file is written whole and renamed into
     place, so a link is never changed through the other name."""
     src = Path(root.file(name))
-    files = sorted((p for p in src.iterdir() if p.is_file() and not p.name.startswith(".")),
-                   key=lambda p: p.name == "metrics.json")  # fmt: skip
+    files = sorted(
+        (p for p in src.iterdir() if p.is_file() and not p.name.startswith(".")),
+        key=lambda p: p.name == "metrics.json",
+    )
     for p in files:
         atomic_write(root.file(p.name), lambda tmp, p=p: _link(p, tmp))
 

@@ -19,8 +19,14 @@ __all__ = ["STATE_COSTS", "ChoiceConfig", "LqrConfig", "TickLearnConfig", "Trial
 #: The model-based law's default λ per feature [per unit²]: eq. 6's 1 on each gyro axis
 #: [(rad/s)²], and 30 on each tilt and the heading [rad²] (a 0.1 rad tilt costs as much as
 #: a 0.55 rad/s rotation).
-STATE_COSTS = {"gyro_x": 1.0, "gyro_y": 1.0, "gyro_z": 1.0, "roll": 30.0, "pitch": 30.0,
-               "heading": 30.0}  # fmt: skip
+STATE_COSTS = {
+    "gyro_x": 1.0,
+    "gyro_y": 1.0,
+    "gyro_z": 1.0,
+    "roll": 30.0,
+    "pitch": 30.0,
+    "heading": 30.0,
+}
 
 
 def _range(name: str, values, lo: float, hi: float) -> None:

@@ -101,8 +101,14 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
         near = [e for s, e in data if abs(s - scale) < 1e-9]
         learned, model = _learned_law(lr, near)
         fell = sum(r.fell for r in res)
-        entry = {"stage": "schedule", "scale": scale, "iteration": state.iteration,
-                 "explore": explore, **summarize(res).to_dict(), "held_out": held}  # fmt: skip
+        entry = {
+            "stage": "schedule",
+            "scale": scale,
+            "iteration": state.iteration,
+            "explore": explore,
+            **summarize(res).to_dict(),
+            "held_out": held,
+        }
         log.append(entry)
         ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
         lr.say(
@@ -146,8 +152,14 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
         table.append((float(frac), run))
     kept = best(table)[0]
     state.trust, state.stage = kept, "done"
-    log.append({"stage": "trust", "scale": lr.trial_scale(state), "kept": kept,
-                "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table]})  # fmt: skip
+    log.append(
+        {
+            "stage": "trust",
+            "scale": lr.trial_scale(state),
+            "kept": kept,
+            "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table],
+        }
+    )
     say_table(lr, f"trust at {lr.trial_scale(state):g}: kept {kept:g}", table)
 
 
@@ -160,8 +172,12 @@ def learn_tick(
         the summary, also written as ``metrics.json``.
     """
     rd = RunDir(run_dir)
-    cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
-                "learner": "tick"}  # fmt: skip
+    cfg_json = {
+        "learn": to_dict(config),
+        "reference": ref.summary(),
+        "robot": robot.name,
+        "learner": "tick",
+    }
     saved, log = rd.start(cfg_json, ref, resume)
     state = TickProgress(**saved) if saved else TickProgress()
     data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []

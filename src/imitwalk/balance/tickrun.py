@@ -104,9 +104,16 @@ def _walk(job: TickJob, ref=None):
     offsets = walk_offsets(ref, job.robot, job.scale, job.seconds, job.feedforward)
     names = job.robot.joint_names
     policy = TickPolicy(
-        ref, job.scale, job.laws, names, job.seconds, job.explore, seed=job.rng,
-        offsets=offsets, wait=job.wait,
-    )  # fmt: skip
+        ref,
+        job.scale,
+        job.laws,
+        names,
+        job.seconds,
+        job.explore,
+        seed=job.rng,
+        offsets=offsets,
+        wait=job.wait,
+    )
     plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
     ro = run(plant, policy, len(policy.q_ref), abandon=abandoned)
     m = walk_metrics(

@@ -122,8 +122,19 @@ class Learner:
         p = self.protocol if protocol is None else load_protocol(protocol)
         return [p.draw(first + j, self.robot, self.ref.sim_options(), seconds) for j in range(n)]
 
-    def run(self, state, scale, laws, draws, seconds, explore=0.0, rng=0, settings=None,
-            first=0, stop=None):  # fmt: skip
+    def run(
+        self,
+        state,
+        scale,
+        laws,
+        draws,
+        seconds,
+        explore=0.0,
+        rng=0,
+        settings=None,
+        first=0,
+        stop=None,
+    ):
         """Walk ``laws`` on ``draws`` (the ``first``-th robot on), the reference played
         with ``settings`` (default: the ones kept); with ``stop``, the shortest prefix of
         the walks it accepts (:func:`~imitwalk.parallel.run_parallel`)."""
@@ -152,8 +163,9 @@ class Learner:
         return out
 
 
-def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most=None,
-          protocol=None) -> Trial:  # fmt: skip
+def trial(
+    lr: Learner, state, key: str, laws, heading=False, settings=None, most=None, protocol=None
+) -> Trial:
     """The trials of ``laws`` at the trial scale (the heading's walks if ``heading``), the
     reference played with ``settings`` (default: the ones kept), on training robots from
     ``protocol`` (``None``: ``train_protocol``), run once per key (kept in the
@@ -176,8 +188,16 @@ def trial(lr: Learner, state, key: str, laws, heading=False, settings=None, most
     if len(done) < n and fell <= limit:
         draws = lr.robots(n - len(done), TRIAL_SEED_BASE + 1 + len(done), seconds, protocol)
         stop = None if most is None else (lambda out: fell + sum(r.fell for r in out) > limit)
-        res = lr.run(state, lr.trial_scale(state), laws, draws, seconds, settings=settings,
-                     first=len(done), stop=stop)  # fmt: skip
+        res = lr.run(
+            state,
+            lr.trial_scale(state),
+            laws,
+            draws,
+            seconds,
+            settings=settings,
+            first=len(done),
+            stop=stop,
+        )
         done += res
     state.tried[key] = [asdict(replace(r, episode=None)) for r in done]
     return Trial(done, n)
@@ -225,15 +245,30 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
 
         def walk(value, most, name=name):
             settings = {**state.settings, name: value}
-            return trial(lr, state, gains_key({}), laws, False, settings, most,
-                         protocol=cfg.trials.balance_protocol)  # fmt: skip
+            return trial(
+                lr,
+                state,
+                gains_key({}),
+                laws,
+                False,
+                settings,
+                most,
+                protocol=cfg.trials.balance_protocol,
+            )
 
         table = _table(lr, state, candidates, walk)
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
-        log.append({"stage": "trials", "gain": name, "kept": kept,
-                    "scale": lr.trial_scale(state), "protocol": cfg.trials.balance_protocol,
-                    "table": rows})  # fmt: skip
+        log.append(
+            {
+                "stage": "trials",
+                "gain": name,
+                "kept": kept,
+                "scale": lr.trial_scale(state),
+                "protocol": cfg.trials.balance_protocol,
+                "table": rows,
+            }
+        )
         say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
         checkpoint(lr, state, log)
 
@@ -282,11 +317,17 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         table = _table(lr, state, getattr(cfg.trials, g.name), walk, limit)
         state.gains[g.name] = kept = best(table, limit)[0]
         log.append(
-            {"stage": "trials", "gain": g.name, "channel": g.channel, "feature": g.feature,
-             "kept": kept, "scale": lr.trial_scale(state),
-             "protocol": protocol or cfg.train_protocol,
-             "table": [{"value": v, **t.summary().to_dict()} for v, t in table]}
-        )  # fmt: skip
+            {
+                "stage": "trials",
+                "gain": g.name,
+                "channel": g.channel,
+                "feature": g.feature,
+                "kept": kept,
+                "scale": lr.trial_scale(state),
+                "protocol": protocol or cfg.train_protocol,
+                "table": [{"value": v, **t.summary().to_dict()} for v, t in table],
+            }
+        )
         say_table(lr, f"trials: {g.feature} -> {g.channel} = {kept:g}", table)
         state.trial += 1
         checkpoint(lr, state, log)

@@ -174,8 +174,9 @@ def learn(args: argparse.Namespace) -> int:
             return res.reference
 
         if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
-            summary, choice = learn_clip(make_reference, robot, cfg, args.out, args.resume,
-                                         progress)  # fmt: skip
+            summary, choice = learn_clip(
+                make_reference, robot, cfg, args.out, args.resume, progress
+            )
             return _learned(summary, args, rd, choice)
         ref = make_reference()
     progress(f"learn: {args.variant} variant")
@@ -217,8 +218,9 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
             "--reference is a joint-space reference for --variant extended or faithful; "
             "the stepping gait learns from the clip itself"
         )
-    unsupported = [f"--{a}" for a in ("turn", "side", "forward", "slope")
-                   if getattr(args, a, None) is not None]  # fmt: skip
+    unsupported = [
+        f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
+    ]
     if unsupported:
         raise ConfigError(
             f"{', '.join(unsupported)}: the stepping gait walks its clip straight ahead on "

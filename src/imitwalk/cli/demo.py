@@ -46,8 +46,15 @@ def run_demo(out: Path) -> dict:
         progress(f"[1/4] style: {Path(motion.source).name} on the robot's legs")
         gait = gait_from_motion(motion, robot, {"robot": "hoap2", "joint_map": None})
         progress("[2/4] learn: the stepping gait's gains by CMA-ES (demo budget)")
-        learn_clip(gait, robot, cfg, out, load_protocol(cfg.protocol), resume=resume,
-                   progress=lambda s: progress("      " + s))  # fmt: skip
+        learn_clip(
+            gait,
+            robot,
+            cfg,
+            out,
+            load_protocol(cfg.protocol),
+            resume=resume,
+            progress=lambda s: progress("      " + s),
+        )
     progress(
         "[3/4] evaluate: learned and shipped gains on the eval protocol's first 8 robots x 20 s"
     )

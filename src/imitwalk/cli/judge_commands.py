@@ -39,9 +39,16 @@ def evaluate(args: argparse.Namespace) -> int:
     if protocol.engine == "bullet":
         progress(f"evaluate: note: {rotor_note(robot)}")
     out = judge_protocol(
-        rd.path, robot, protocol, args.seeds, args.seconds, controllers=chosen,
-        scale=args.scale, workers=args.workers, explain=args.explain_falls,
-    )  # fmt: skip
+        rd.path,
+        robot,
+        protocol,
+        args.seeds,
+        args.seconds,
+        controllers=chosen,
+        scale=args.scale,
+        workers=args.workers,
+        explain=args.explain_falls,
+    )
     for name, side in out.controllers.items():
         lo, hi = side.survival_ci95
         progress(

@@ -55,8 +55,16 @@ def convert(args: argparse.Namespace) -> int:
         motion = read_robot_motion(src, robot)
     (write_gmr if args.to == "gmr" else write_locomujoco)(motion, robot, out)
     progress(f"convert: {src} -> {out} ({args.to}, {motion.n_frames} frames at {motion.fps:g} Hz)")
-    emit({"out": str(out), "format": args.to, "robot": robot.name, "frames": motion.n_frames,
-          "fps": motion.fps}, args.json)  # fmt: skip
+    emit(
+        {
+            "out": str(out),
+            "format": args.to,
+            "robot": robot.name,
+            "frames": motion.n_frames,
+            "fps": motion.fps,
+        },
+        args.json,
+    )
     return 0
 
 

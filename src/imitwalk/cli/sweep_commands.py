@@ -21,9 +21,18 @@ def sweep(args: argparse.Namespace) -> int:
     progress(f"sweep: {n} cells into {args.out}, on {where}")
     res = run_sweep(cfg, args.out, args.address, args.workers, show_progress=not args.json)
     progress(f"sweep: {res.ran} run, {res.kept} kept from before, {res.refused} refused")
-    emit({"out": res.out, "cells": res.cells, "ran": res.ran, "kept": res.kept,
-          "refused": res.refused, "table": f"{res.out}/results.csv",
-          "summary": f"{res.out}/summary.md"}, args.json)  # fmt: skip
+    emit(
+        {
+            "out": res.out,
+            "cells": res.cells,
+            "ran": res.ran,
+            "kept": res.kept,
+            "refused": res.refused,
+            "table": f"{res.out}/results.csv",
+            "summary": f"{res.out}/summary.md",
+        },
+        args.json,
+    )
     return 0
 
 

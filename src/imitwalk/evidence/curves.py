@@ -134,8 +134,9 @@ def tick_curves(log: Sequence[dict]) -> Figure:
     axes[0].set_ylabel("falls")
     axes[1].plot(it, [e["cost"] for e in sched], "o-", label="measured Γ")
     axes[1].set_ylabel("cost Γ(ω)")
-    ratio = [np.nan if not e.get("held_out") else e["held_out"]["ratio_to_persistence"]
-             for e in sched]  # fmt: skip
+    ratio = [
+        np.nan if not e.get("held_out") else e["held_out"]["ratio_to_persistence"] for e in sched
+    ]
     axes[2].plot(it, ratio, "o-", label="model / persistence")
     axes[2].axhline(1.0, color="k", ls="--", lw=0.8, label='"nothing changes"')
     axes[2].set_ylabel("held-out MSE ratio")

@@ -30,12 +30,23 @@ __all__ = [
 TWO_PI = 2.0 * np.pi
 #: Stick-figure bones between :data:`imitwalk.mocap.KEYPOINTS`; the side is the first letter.
 BONES = (
-    ("pelvis", "l_hip"), ("l_hip", "l_knee"), ("l_knee", "l_ankle"), ("l_ankle", "l_toe"),
-    ("pelvis", "r_hip"), ("r_hip", "r_knee"), ("r_knee", "r_ankle"), ("r_ankle", "r_toe"),
-    ("pelvis", "neck"), ("neck", "head"), ("neck", "l_shoulder"), ("l_shoulder", "l_elbow"),
-    ("l_elbow", "l_wrist"), ("neck", "r_shoulder"), ("r_shoulder", "r_elbow"),
+    ("pelvis", "l_hip"),
+    ("l_hip", "l_knee"),
+    ("l_knee", "l_ankle"),
+    ("l_ankle", "l_toe"),
+    ("pelvis", "r_hip"),
+    ("r_hip", "r_knee"),
+    ("r_knee", "r_ankle"),
+    ("r_ankle", "r_toe"),
+    ("pelvis", "neck"),
+    ("neck", "head"),
+    ("neck", "l_shoulder"),
+    ("l_shoulder", "l_elbow"),
+    ("l_elbow", "l_wrist"),
+    ("neck", "r_shoulder"),
+    ("r_shoulder", "r_elbow"),
     ("r_elbow", "r_wrist"),
-)  # fmt: skip
+)
 SIDE_COLOR = {"l_": "tab:blue", "r_": "tab:red"}
 RINGS = {"facecolors": "none", "edgecolors": "red"}
 

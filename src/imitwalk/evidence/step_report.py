@@ -73,14 +73,22 @@ def imitation_rows(lg: LoadedRun, ro: Rollout, robot: Robot) -> list[tuple[str, 
     if timing.stride_m is not None and timing.cycle_s:
         speed = timing.stride_m / timing.cycle_s
     return [
-        ("cadence [steps/min]", _fmt(120.0 / human["period"], ".1f"),
-         _fmt(60.0 / st.step_time, ".1f"), _fmt(timing.cadence_spm, ".1f")),
-        ("stride [m]", _fmt(human["stride"], ".3f"), _fmt(2 * st.step_length, ".3f"),
-         _fmt(timing.stride_m, ".3f")),
+        (
+            "cadence [steps/min]",
+            _fmt(120.0 / human["period"], ".1f"),
+            _fmt(60.0 / st.step_time, ".1f"),
+            _fmt(timing.cadence_spm, ".1f"),
+        ),
+        (
+            "stride [m]",
+            _fmt(human["stride"], ".3f"),
+            _fmt(2 * st.step_length, ".3f"),
+            _fmt(timing.stride_m, ".3f"),
+        ),
         ("speed [m/s]", _fmt(human["speed"], ".2f"), _fmt(st.speed, ".3f"), _fmt(speed, ".3f")),
         ("leg [m]", _fmt(human["leg"], ".3f"), _fmt(st.geometry.leg, ".3f"), ""),
         ("toe scuffs mid-swing", "", "0", str(timing.scuffs)),
-    ]  # fmt: skip
+    ]
 
 
 def _imitation(lg: LoadedRun, robot: Robot, runs, strip: str) -> str:

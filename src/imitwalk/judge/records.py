@@ -120,8 +120,9 @@ class ControllerVerdict:
 def _own(cls, d: dict) -> dict[str, Any]:
     """``cls``'s fields as ``d`` holds them; a field later releases added with a default
     of ``None`` is ``None`` where ``d``, written before, lacks it."""
-    return {f.name: d[f.name] if f.name in d or f.default is not None else None
-            for f in fields(cls)}  # fmt: skip
+    return {
+        f.name: d[f.name] if f.name in d or f.default is not None else None for f in fields(cls)
+    }
 
 
 def _row_dict(r: SeedRow) -> dict:

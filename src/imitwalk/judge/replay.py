@@ -98,8 +98,10 @@ class LoadedRun:
     def settings_of(self, controller: str) -> dict:
         """How ``controller`` plays the reference: ``feedforward`` and ``wait`` (0: not)."""
         mine = (self.settings or {}) if controller in ("learned", "feedback") else {}
-        return {"feedforward": float(mine.get("feedforward", 0.0)),
-                "wait": float(mine.get("wait", 0.0))}  # fmt: skip
+        return {
+            "feedforward": float(mine.get("feedforward", 0.0)),
+            "wait": float(mine.get("wait", 0.0)),
+        }
 
     def controllers(self) -> tuple[str, ...]:
         """The controllers it can build (a joint-space run's ``open_loop`` last)."""
@@ -150,8 +152,12 @@ class LoadedRun:
         if controller not in self.controllers():
             raise unknown_name("controller", controller, self.controllers(), ConfigError)
         scale = self.scale if scale is None else scale
-        source = {"run": self.path, "learner": self.learner, "controller": controller,
-                  "scale": scale}  # fmt: skip
+        source = {
+            "run": self.path,
+            "learner": self.learner,
+            "controller": controller,
+            "scale": scale,
+        }
         if self.actor is not None and controller == "rl":
             if self.actor[0].layout.action == "joints":
                 return Bundle("rl-joints", robot, self.ref.dt, actor=self.actor, source=source)
@@ -231,8 +237,15 @@ def load_run(run_dir) -> LoadedRun:
             raise RunError(
                 f"{rd.file('gains.json')} is not a stepping run's gains: {exc}"
             ) from None
-        return LoadedRun(str(rd.path), "step", gait, float(metrics.scale_reached), engine, metrics,
-                         step_gains=gains)  # fmt: skip
+        return LoadedRun(
+            str(rd.path),
+            "step",
+            gait,
+            float(metrics.scale_reached),
+            engine,
+            metrics,
+            step_gains=gains,
+        )
     if config.get("learner") == "tick":
         from imitwalk.balance.tickstore import load_laws
 

@@ -86,8 +86,12 @@ def learn(
         the learning summary (also written as ``metrics.json``).
     """
     rd = RunDir(run_dir)
-    cfg_json = {"learn": to_dict(config), "reference": ref.summary(), "robot": robot.name,
-                "learner": "faithful"}  # fmt: skip
+    cfg_json = {
+        "learn": to_dict(config),
+        "reference": ref.summary(),
+        "robot": robot.name,
+        "learner": "faithful",
+    }
     canonical = lambda learn: to_dict(from_dict(LearnConfig, learn))  # noqa: E731
     saved, log = rd.start(cfg_json, ref, resume, canonical)
     state = FaithfulProgress(**saved) if saved else FaithfulProgress()

@@ -108,8 +108,7 @@ def _cycles(ref: Reference, robot, scale: float) -> tuple[np.ndarray, np.ndarray
     robot in a process (the last few kept), with the walks built from them by length."""
     m, n = ref.starts.shape[1], ref.loops.shape[1]
     q = ref.trajectory(scale, (m + 3 * n) * ref.dt)
-    key = (hashlib.sha1(q.tobytes()).hexdigest(), str(robot.mjcf), robot.name,
-           robot.kp.tobytes())  # fmt: skip
+    key = (hashlib.sha1(q.tobytes()).hexdigest(), str(robot.mjcf), robot.name, robot.kp.tobytes())
     if key not in _CACHE:
         if len(_CACHE) >= 4:
             _CACHE.pop(next(iter(_CACHE)))

@@ -191,8 +191,9 @@ def motion_of_reference(
             anchor_yaw = float(np.arctan2(rel[1, 0], rel[0, 0]))
             anchor_pos = np.array([o_pos[0], o_pos[1], height[other]])
             side = other
-    return RobotMotion(robot.name, 1.0 / ref.dt, root_pos, root_quat, q, robot.joint_names,
-                       str(ref.source))  # fmt: skip
+    return RobotMotion(
+        robot.name, 1.0 / ref.dt, root_pos, root_quat, q, robot.joint_names, str(ref.source)
+    )
 
 
 def clip_of_motion(motion: RobotMotion, robot: Robot) -> Motion:
@@ -217,8 +218,20 @@ def clip_of_motion(motion: RobotMotion, robot: Robot) -> Motion:
     jid = {r: m.joint(robot.mj_joints[robot.index(r)]).id for r in need}
     ball = BALL * leg_geometry(robot).foot_length
     t = motion.n_frames
-    keys = {k: np.zeros((t, 3)) for k in ("pelvis", "l_hip", "r_hip", "l_knee", "r_knee",
-                                          "l_ankle", "r_ankle", "l_toe", "r_toe")}  # fmt: skip
+    keys = {
+        k: np.zeros((t, 3))
+        for k in (
+            "pelvis",
+            "l_hip",
+            "r_hip",
+            "l_knee",
+            "r_knee",
+            "l_ankle",
+            "r_ankle",
+            "l_toe",
+            "r_toe",
+        )
+    }
     for k in range(t):
         kin.pose(motion.root_pos[k], motion.root_quat[k], motion.joints[k])
         keys["pelvis"][k] = d.xpos[kin.root]

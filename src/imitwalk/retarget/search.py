@@ -132,8 +132,15 @@ class SearchConfig:
 _IK: dict = {}
 
 
-def open_loop(ref, robot: Robot, scale: float, seed: int, options: SimOptions,
-              seconds: float, engine: str = "mujoco") -> WalkMetrics:  # fmt: skip
+def open_loop(
+    ref,
+    robot: Robot,
+    scale: float,
+    seed: int,
+    options: SimOptions,
+    seconds: float,
+    engine: str = "mujoco",
+) -> WalkMetrics:
     """The search's default :data:`Walker`: ``ref`` played open loop on ``engine``
     (``seed`` is drawn into ``options`` already)."""
     q = ref.trajectory(scale, seconds)

@@ -135,12 +135,18 @@ def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
             block["mjcf_sensors"] = [*r.foot_force["l"], *r.foot_force["r"]]
         blocks.append(block)
     joints = [
-        {"name": n, "mjcf_joint": mj, "sign": int(s), "unit": "rad", "stand": float(q0),
-         "range": [float(lo), float(hi)]}
+        {
+            "name": n,
+            "mjcf_joint": mj,
+            "sign": int(s),
+            "unit": "rad",
+            "stand": float(q0),
+            "range": [float(lo), float(hi)],
+        }
         for n, mj, s, q0, (lo, hi) in zip(
             r.joint_names, r.mj_joints, r.signs, r.stand, r.limits, strict=True
         )
-    ]  # fmt: skip
+    ]
     from imitwalk import __version__
 
     return {
@@ -153,10 +159,15 @@ def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
         "control": {"rate_hz": 1.0 / b.dt, "dt_s": b.dt},
         "joints": joints,
         "sensors": {"size": lay.size, "blocks": blocks},
-        "output": {"name": "joint targets", "size": r.dof, "unit": "rad",
-                   "order": "the joints, with their signs", "to": "position servos"},
+        "output": {
+            "name": "joint targets",
+            "size": r.dof,
+            "unit": "rad",
+            "order": "the joints, with their signs",
+            "to": "position servos",
+        },
         "files": files,
-    }  # fmt: skip
+    }
 
 
 def _write_parts(b: Bundle, folder: Path) -> None:

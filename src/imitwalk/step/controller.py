@@ -135,8 +135,14 @@ class SteppingController:
         self.stance, self.single, self.t_phase, self.steps = "r", False, 0.0, 0
         self.ds_time = (SETTLE + SHIFT) * st.step_time
         self.trail = FootPose(e.swing.pos.copy(), e.swing.yaw)  # the left foot, down
-        self.swing = SwingFoot(st.swing_x, st.swing_z, st.clearance, LATE * st.step_time,
-                               g.swing_fix, 0.1 * st.geometry.leg)  # fmt: skip
+        self.swing = SwingFoot(
+            st.swing_x,
+            st.swing_z,
+            st.clearance,
+            LATE * st.step_time,
+            g.swing_fix,
+            0.1 * st.geometry.leg,
+        )
         self.landing, self.land_yaw = np.array([0.0, st.step_width]), 0.0
         self.ss = st.single_support
         self.c_ref, self.v_ref = e.com[:2].copy(), np.zeros(2)
@@ -189,10 +195,18 @@ class SteppingController:
             nominal, offset = turning_step(gait.step, gait.width, side, self.command.turn, offset)
         if self.single:
             choice = plan_step(
-                e.dcm, side, gait, self.nominal.limits, self.nominal.weights,
-                elapsed=self.t_phase, zmp_now=zmp_plan, swing_at=self.swing.pose.pos[:2],
-                nominal_step=nominal, offset=offset, zmp_box=self._zmp_box(zmp_plan, toe),
-            )  # fmt: skip
+                e.dcm,
+                side,
+                gait,
+                self.nominal.limits,
+                self.nominal.weights,
+                elapsed=self.t_phase,
+                zmp_now=zmp_plan,
+                swing_at=self.swing.pose.pos[:2],
+                nominal_step=nominal,
+                offset=offset,
+                zmp_box=self._zmp_box(zmp_plan, toe),
+            )
             self.landing, self.ss = choice.landing, self.t_phase + choice.remaining
             zmp_plan = zmp_plan + choice.zmp_shift
             toe = toe + choice.zmp_shift
@@ -218,14 +232,25 @@ class SteppingController:
         turn = g.heading * err + (1.0 - g.heading) * self.command.turn  # a turn fed forward
         self.land_yaw = float(min(max(turn, -MAX_STEP_YAW), MAX_STEP_YAW))
         if self.single:
-            self.swing.advance(self.t_phase, self.ss, self.landing, self.land_yaw,
-                               e.swing.pos, dt, e.slope)  # fmt: skip
+            self.swing.advance(
+                self.t_phase, self.ss, self.landing, self.land_yaw, e.swing.pos, dt, e.slope
+            )
         q = self._joints(e)
         if self.log:
             self.ticks.append(
-                TickLog(k * dt, self.stance, self.single, self.steps, e.dcm.copy(), xi_ref.copy(),
-                        self.zmp.copy(), self.c_ref.copy(), self.landing.copy(), self.ss)
-            )  # fmt: skip
+                TickLog(
+                    k * dt,
+                    self.stance,
+                    self.single,
+                    self.steps,
+                    e.dcm.copy(),
+                    xi_ref.copy(),
+                    self.zmp.copy(),
+                    self.c_ref.copy(),
+                    self.landing.copy(),
+                    self.ss,
+                )
+            )
         self.t_phase += dt
         self._advance(e)
         return q
@@ -260,8 +285,9 @@ class SteppingController:
         shares = self._shares()
         loads = {side: (w, self._press(side)) for side, w in shares.items() if w > 0.0}
         com = self.c_ref + g.lead * self.v_ref
-        return self.joints.solve(self.stance, com, height, other, self._phase(), loads,
-                                 self.ankle_zmp)  # fmt: skip
+        return self.joints.solve(
+            self.stance, com, height, other, self._phase(), loads, self.ankle_zmp
+        )
 
     def _press(self, side: str) -> np.ndarray:
         """Where ``side``'s sole presses ``(3,)`` [m] (stance frame): the stance sole at

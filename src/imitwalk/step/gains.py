@@ -110,8 +110,9 @@ class StepGains:
 
     def vector(self, names: tuple[str, ...]) -> np.ndarray:
         """The gains ``names`` as a vector, each scaled to [0, 1] of its range."""
-        return np.array([(getattr(self, n) - BOUNDS[n].lo) / (BOUNDS[n].hi - BOUNDS[n].lo)
-                         for n in names])  # fmt: skip
+        return np.array(
+            [(getattr(self, n) - BOUNDS[n].lo) / (BOUNDS[n].hi - BOUNDS[n].lo) for n in names]
+        )
 
     def with_vector(self, names: tuple[str, ...], x: np.ndarray) -> StepGains:
         """These gains with ``names`` set from ``x`` (each in [0, 1] of its range, clipped)."""

@@ -210,8 +210,9 @@ def learn_step(
     else:
         x0 = start.vector(cfg.names)
         bounds = np.tile([0.0, 1.0], (len(cfg.names), 1))
-        opt = CMA(mean=x0, sigma=cfg.sigma, bounds=bounds, population_size=cfg.population,
-                  seed=cfg.seed)  # fmt: skip
+        opt = CMA(
+            mean=x0, sigma=cfg.sigma, bounds=bounds, population_size=cfg.population, seed=cfg.seed
+        )
         spent = 0.0
     for gen in range(len(log), cfg.generations):
         # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
@@ -226,20 +227,27 @@ def learn_step(
         opt.tell(list(zip(xs, costs, strict=True)))
         k = int(np.argmin(costs))
         falls = [sum(r.fell for r in s) for s in scores]
-        log.append({
-            "generation": gen + 1,
-            "best_cost": costs[k],
-            "mean_cost": float(np.mean(costs)),
-            "best_falls": falls[k],
-            "robots": cfg.robots,
-            "best_gains": cands[k].to_dict(),
-        })  # fmt: skip
+        log.append(
+            {
+                "generation": gen + 1,
+                "best_cost": costs[k],
+                "mean_cost": float(np.mean(costs)),
+                "best_falls": falls[k],
+                "robots": cfg.robots,
+                "best_gains": cands[k].to_dict(),
+            }
+        )
         say(
             f"learn: generation {gen + 1}/{cfg.generations}: best cost {costs[k]:.3f} "
             f"({falls[k]}/{cfg.robots} fell), mean {np.mean(costs):.3f}"
         )
-        state = {"config": cfg.to_dict(), "cma": opt, "log": log, "sim_seconds": spent,
-                 "wall": time.perf_counter() - t0}  # fmt: skip
+        state = {
+            "config": cfg.to_dict(),
+            "cma": opt,
+            "log": log,
+            "sim_seconds": spent,
+            "wall": time.perf_counter() - t0,
+        }
         atomic_write(rd.file("cma.pkl"), lambda tmp, s=state: tmp.write_bytes(pickle.dumps(s)))
         rd.write_log(log)
     finalists = {"start": start}

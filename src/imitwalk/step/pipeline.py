@@ -79,8 +79,7 @@ def learn_clip(
     """
     rd = RunDir(out)
     t0 = time.perf_counter()
-    config = {"learner": "step", "learn": cfg.to_dict(), "robot": robot.name,
-              "source": gait.source}  # fmt: skip
+    config = {"learner": "step", "learn": cfg.to_dict(), "robot": robot.name, "source": gait.source}
     if resume:
         if not rd.exists("style.json"):
             raise RunError(f"nothing to resume in {rd.path}: no style.json")

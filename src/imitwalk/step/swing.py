@@ -36,8 +36,9 @@ class SwingFoot:
         correction's bound per axis [m].
     """
 
-    def __init__(self, shape_x, shape_z, clearance: float, late_s: float, rate: float,
-                 limit: float):  # fmt: skip
+    def __init__(
+        self, shape_x, shape_z, clearance: float, late_s: float, rate: float, limit: float
+    ):
         self.shape_x, self.shape_z = np.asarray(shape_x), np.asarray(shape_z)
         self._gx = np.linspace(0.0, 1.0, len(self.shape_x))  # σ of each profile sample
         self._gz = np.linspace(0.0, 1.0, len(self.shape_z))
@@ -50,8 +51,16 @@ class SwingFoot:
         self.sigma = 0.0
         self.fix = np.zeros(3)
 
-    def advance(self, elapsed: float, duration: float, landing: np.ndarray, yaw: float,
-                measured: np.ndarray, dt: float, slope=(0.0, 0.0)) -> FootPose:  # fmt: skip
+    def advance(
+        self,
+        elapsed: float,
+        duration: float,
+        landing: np.ndarray,
+        yaw: float,
+        measured: np.ndarray,
+        dt: float,
+        slope=(0.0, 0.0),
+    ) -> FootPose:
         """Move the foot for the tick ending ``elapsed`` [s] into a swing of ``duration``
         [s] towards ``landing`` ``(2,)`` [m] and heading ``yaw`` [rad]; ``measured``
         ``(3,)``: where the encoders put the sole [m]; ``slope``: the floor's rise per

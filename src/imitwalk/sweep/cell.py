@@ -60,9 +60,17 @@ class CellJob:
 def _row(job: CellJob, status: str, **values: Any) -> dict[str, Any]:
     c = job.cell
     row: dict[str, Any] = dict.fromkeys(COLUMNS)
-    row.update(cell=c.name, clip=c.clip, robot=c.robot, settings=" ".join(c.settings),
-               seed=c.seed, status=status, protocol=job.protocol,
-               judged_robots=job.judge_robots, seconds=job.seconds)  # fmt: skip
+    row.update(
+        cell=c.name,
+        clip=c.clip,
+        robot=c.robot,
+        settings=" ".join(c.settings),
+        seed=c.seed,
+        status=status,
+        protocol=job.protocol,
+        judged_robots=job.judge_robots,
+        seconds=job.seconds,
+    )
     row.update(values)
     return row
 
@@ -88,9 +96,14 @@ def run_cell(job: CellJob) -> dict[str, Any]:
         where = {"robot": c.robot, "joint_map": None}
         summary = learn(clip, robot, str(run_dir), cfg, resume, None, where)
         verdict = judge_protocol(
-            str(run_dir), robot, load_protocol(job.protocol), job.judge_robots, job.seconds,
-            controllers=("learned",), workers=1,
-        )  # fmt: skip
+            str(run_dir),
+            robot,
+            load_protocol(job.protocol),
+            job.judge_robots,
+            job.seconds,
+            controllers=("learned",),
+            workers=1,
+        )
         v = verdict.controllers["learned"]
         row = _row(
             job,

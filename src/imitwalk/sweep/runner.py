@@ -90,8 +90,9 @@ def run_sweep(
     out = Path(out)
     _start(cfg, out)
     cells = cfg.cells()
-    jobs = [CellJob(c, str(out / c.name), cfg.protocol, cfg.judge_robots, cfg.seconds)
-            for c in cells]  # fmt: skip
+    jobs = [
+        CellJob(c, str(out / c.name), cfg.protocol, cfg.judge_robots, cfg.seconds) for c in cells
+    ]
     rows: dict[int, dict[str, Any]] = {}
     for i, j in enumerate(jobs):
         row = _read_row(Path(j.folder) / ROW)
@@ -107,8 +108,13 @@ def run_sweep(
     if todo:
         if not ray.is_initialized():
             kw: dict[str, Any] = {"num_cpus": workers} if address is None else {}
-            ray.init(address=address, include_dashboard=False, log_to_driver=False,
-                     configure_logging=False, **kw)  # fmt: skip
+            ray.init(
+                address=address,
+                include_dashboard=False,
+                log_to_driver=False,
+                configure_logging=False,
+                **kw,
+            )
             started = True
         task = ray.remote(num_cpus=1)(run_cell)
         refs = {task.remote(jobs[i]): i for i in todo}

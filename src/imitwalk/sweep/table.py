@@ -57,8 +57,12 @@ def _summary(rows: list[dict[str, Any]], cells: int) -> str:
             f"| {_fmt(r['learn_sim_s'], '.0f')}, {_fmt(r['learn_wall_s'], '.0f')} "
             f"| {r['status']} |"
         )
-    lines += ["", f"Robots judged on protocol {rows[0]['protocol']!r} for "
-              f"{rows[0]['seconds']:g} s each." if rows else ""]  # fmt: skip
+    lines += [
+        "",
+        f"Robots judged on protocol {rows[0]['protocol']!r} for {rows[0]['seconds']:g} s each."
+        if rows
+        else "",
+    ]
     return "\n".join(lines) + "\n"
 
 
