@@ -1,4 +1,4 @@
-"""The policy that walks a course: the stepping gait steered by its own odometry (pure NumPy).
+"""The policy that walks a course: the stepping gait steered by its own odometry.
 
 Every control tick the :class:`Navigator` reads where the robot is by its own sensors
 (:attr:`SteppingController.pose <imitwalk.step.controller.SteppingController.pose>`: leg
@@ -103,7 +103,7 @@ class Navigator:
 
     def fix(self, xy: np.ndarray) -> None:
         """A position fix: the body measured at ``xy`` ``(2,)`` [m] in the start frame."""
-        if self.ctrl._started:
+        if self.ctrl.started:
             pose = self.ctrl.pose
             self.ctrl.odometry.fix(xy, pose.xy, self.fix_weight)
 
@@ -123,7 +123,7 @@ class Navigator:
         return StepCommand(heading=heading, stride=self.stride)
 
     def __call__(self, k: int, obs) -> np.ndarray:
-        if k > 0 and self.ctrl._started:
+        if k > 0 and self.ctrl.started:
             self.ctrl.steer(self._command())
         q = self.ctrl(k, obs)
         pose = self.ctrl.pose

@@ -118,6 +118,11 @@ class SteppingController:
         self._stride = round(command.stride * 20) / 20
 
     @property
+    def started(self) -> bool:
+        """Whether it has taken its first tick (and so knows where it stands)."""
+        return self._started
+
+    @property
     def pose(self) -> Pose2D:
         """Where the robot is by its own sensors (:mod:`imitwalk.step.odometry`): the
         centre of mass and the stance sole's heading in the start frame."""
