@@ -34,10 +34,7 @@ from imitwalk.robots import Robot
 from imitwalk.step.estimator import BodyEstimate, BodyEstimator, ObserverNoise
 from imitwalk.step.gains import StepGains
 from imitwalk.step.joints import JointSolver
-from imitwalk.step.kinematics import BodyModel, FootPose, floor_mat, rot_z
-import os
-_TRUE = [float(x) for x in os.environ["IW_TRUE"].split(",")] if os.environ.get("IW_TRUE") else None
-_SWING = os.environ.get("IW_SWING") == "1"
+from imitwalk.step.kinematics import BodyModel, FootPose, rot_z
 from imitwalk.step.lipm import GRAVITY, dcm_before, lipm_step, omega_of
 from imitwalk.step.nominal import NominalWalk, turning_step
 from imitwalk.step.odometry import LegOdometry, Pose2D, StepCommand
@@ -193,13 +190,6 @@ class SteppingController:
             self._start(obs)
         dt, g = self.dt, self.gains
         e = self.est.update(obs, self.zmp)
-        if _TRUE is not None:
-            h = e.heading
-            c, s_ = np.cos(h), np.sin(h)
-            self._slope = np.array([c * _TRUE[0] + s_ * _TRUE[1], -s_ * _TRUE[0] + c * _TRUE[1]])
-            from dataclasses import replace as _r
-            if _SWING:
-                e = _r(e, slope=self._slope)
         self._com, self._heading = e.com[:2], e.heading
         side = 1.0 if self.stance == "l" else -1.0
         gait = self.nominal.gait(self.steps + 1, self._stride)
@@ -300,9 +290,8 @@ class SteppingController:
         shares = self._shares()
         loads = {side: (w, self._press(side)) for side, w in shares.items() if w > 0.0}
         com = self.c_ref + g.lead * self.v_ref
-        floor = floor_mat(self._slope) if _TRUE is not None else None
         return self.joints.solve(
-            self.stance, com, height, other, self._phase(), loads, self.ankle_zmp, floor
+            self.stance, com, height, other, self._phase(), loads, self.ankle_zmp
         )
 
     def _press(self, side: str) -> np.ndarray:

@@ -82,7 +82,6 @@ class JointSolver:
         phase: float,
         loads: dict[str, tuple[float, np.ndarray]],
         ankle_zmp: np.ndarray,
-        floor: np.ndarray | None = None,
     ) -> np.ndarray:
         """Joint targets ``(n,)`` [rad].
 
@@ -99,7 +98,7 @@ class JointSolver:
         turn = rot_z(0.5 * other.yaw)
         swing = "l" if stance == "r" else "r"
         feet = {stance: FootPose(-pelvis, 0.0), swing: FootPose(other.pos - pelvis, other.yaw)}
-        q = self.ik.solve_legs(self.q, feet, turn, iterations=2, floor=floor)
+        q = self.ik.solve_legs(self.q, feet, turn, iterations=2)
         offsets = self.style.upper_at(phase)
         for role, j in self._upper.items():
             q[j] = r.stand[j] + offsets[role]

@@ -45,10 +45,6 @@ def rot_xyz(roll: float, pitch: float, yaw: float) -> np.ndarray:
     return rot_z(yaw) @ ry @ rx
 
 
-def floor_mat(slope) -> np.ndarray:
-    return rot_xyz(float(np.arctan(slope[1])), -float(np.arctan(slope[0])), 0.0)
-
-
 def _quat(mat: np.ndarray) -> np.ndarray:
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, np.ascontiguousarray(mat).ravel())
@@ -192,7 +188,6 @@ class BodyModel:
         pelvis_mat: np.ndarray,
         iterations: int = 3,
         damping: float = 1e-6,
-        floor: np.ndarray | None = None,
     ) -> np.ndarray:
         """Leg joints that put each sole at its pose, the pelvis at the origin turned by
         ``pelvis_mat`` (foot poses in the same frame as the pelvis's).
@@ -208,8 +203,7 @@ class BodyModel:
         """
         m, d = self.m, self.d
         q = q.copy()
-        tilt = (lambda yaw: rot_z(yaw)) if floor is None else (lambda yaw: floor @ rot_z(yaw))
-        targets = {s: (f.pos, tilt(f.yaw) @ self._flat[s]) for s, f in feet.items()}
+        targets = {s: (f.pos, rot_z(f.yaw) @ self._flat[s]) for s, f in feet.items()}
         for _ in range(iterations):
             self.set(q, pelvis_mat)
             for s, (pos, mat) in targets.items():
