@@ -76,7 +76,7 @@ def test_evaluate_explains_the_falls_when_asked(run, capsys):
     [
         (
             ["--protocol", "nosuch"],
-            "unknown protocol 'nosuch'; valid: bullet, eval, hard, servo, slope",
+            "unknown protocol 'nosuch'; valid: bullet, cross, eval, hard, servo, slope",
         ),
         (
             ["--controllers", "nosuch"],

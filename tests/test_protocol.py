@@ -157,7 +157,9 @@ def test_bad_protocol_files_get_one_line(tmp_path, change, message):
 
 
 def test_an_unknown_protocol_lists_the_shipped_ones():
-    with pytest.raises(ConfigError, match=r"unknown protocol 'harder'; valid: bullet, eval, hard"):
+    with pytest.raises(
+        ConfigError, match=r"unknown protocol 'harder'; valid: bullet, cross, eval, hard"
+    ):
         load_protocol("harder")
 
 
@@ -189,6 +191,7 @@ FIELDS = {
     "accel_noise": ("accel_noise",),
     "servo_delay": ("servo_delay",),
     "slope": ("slope_deg",),
+    "cross_slope": ("cross_slope_deg",),
     "pushes": ("pushes",),
     "initial_twist": ("init_twist",),
 }
@@ -210,3 +213,30 @@ def test_a_factor_left_out_is_nominal_and_every_other_is_drawn_as_before(robot, 
         for f in fields(SimOptions):
             want = getattr(nominal if f.name in FIELDS[factor] else full, f.name)
             assert getattr(less, f.name) == want, (factor, f.name)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(-10, 10), st.floats(-10, 10))
+def test_gravity_tilts_both_ways_and_is_unchanged_without_a_cross_slope(sx, sy):
+    """The floor is the plane z = 0 and gravity leans: a floor rising along +x (or +y)
+    pulls the robot back along -x (or -y)."""
+    from imitwalk.sim.types import gravity
+
+    g = gravity(SimOptions(slope_deg=sx, cross_slope_deg=sy))
+    assert np.isclose(np.linalg.norm(g), 9.81) and g[2] < 0
+    assert np.sign(g[0]) == -np.sign(sx) and np.sign(g[1]) == -np.sign(sy)
+    th, ph = np.deg2rad(sx), np.deg2rad(sy)
+    assert np.array_equal(
+        gravity(SimOptions(slope_deg=sx)), 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+    )
+    across = gravity(SimOptions(cross_slope_deg=sy))
+    assert np.allclose(across, 9.81 * np.array([0.0, -np.sin(ph), -np.cos(ph)]))
+
+
+def test_cross_draws_evals_robots_on_floors_sloped_across(robot):
+    cross, ev = load_protocol("cross"), load_protocol("eval")
+    for seed in range(1, 8):
+        o, e = cross.draw(seed, robot).options, ev.draw(seed, robot).options
+        assert -3.0 <= o.cross_slope_deg <= 3.0 and o.cross_slope_deg != 0.0
+        assert o.slope_deg == 0.0 and o.friction == e.friction
+    assert cross.draw(0, robot).options.cross_slope_deg == 0.0

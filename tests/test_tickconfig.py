@@ -66,7 +66,9 @@ def test_a_schedule_that_cannot_be_walked_is_refused(sets):
 def test_names_are_checked_with_the_valid_ones_listed():
     with pytest.raises(ConfigError, match=r"engine 'physx'; valid: "):
         TickLearnConfig(engine="physx")
-    with pytest.raises(ConfigError, match=r"unknown protocol 'harder'; valid: bullet, eval, hard"):
+    with pytest.raises(
+        ConfigError, match=r"unknown protocol 'harder'; valid: bullet, cross, eval, hard"
+    ):
         TickLearnConfig(train_protocol="harder")
     with pytest.raises(ConfigError, match=r"unknown protocol 'srvo'; valid: .*servo"):
         apply_overrides(TickLearnConfig(), ["trials.balance_protocol=srvo"])

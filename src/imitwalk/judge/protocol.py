@@ -20,6 +20,8 @@ Factors (every key of each is listed in :data:`FACTORS`):
   [rad/s], [m/s²] (not a draw: no percentile);
 * ``servo_delay``: the command reaches the servos U(min_s, max_s) late [s];
 * ``slope``: the floor slopes U(min_deg, max_deg) along the walk (+: uphill);
+* ``cross_slope``: the floor slopes U(min_deg, max_deg) across the walk (+: rising to
+  the robot's left);
 * ``pushes``: a kick every U(every_min_s, every_max_s) seconds, in a uniformly random
   horizontal direction, of a speed U(0, v) with ``v = max_speed ×
   sqrt(height / at_height_m)`` [m/s] (Froude scaling: the same kick for a small and a
@@ -53,7 +55,7 @@ from imitwalk.sim.types import SimOptions, jitter_draws
 __all__ = ["FACTORS", "PROTOCOLS", "Protocol", "RobotDraw", "load_protocol"]
 
 #: The stream of each factor that does not share the legacy one (see the module doc).
-_STREAM = {"torso_com": 1, "servo_delay": 2, "slope": 3, "pushes": 4}
+_STREAM = {"torso_com": 1, "servo_delay": 2, "slope": 3, "pushes": 4, "cross_slope": 5}
 _LEGACY = 20070106
 
 #: The protocols shipped with imitwalk, by name.
@@ -158,6 +160,11 @@ class Protocol:
             value = lo + (hi - lo) * self._stream(seed, "slope").random()
             opt["slope_deg"] = base.slope_deg + value
             dev["slope"] = _symmetric_percentile(value, lo, hi)
+        if "cross_slope" in f:
+            lo, hi = f["cross_slope"]["min_deg"], f["cross_slope"]["max_deg"]
+            value = lo + (hi - lo) * self._stream(seed, "cross_slope").random()
+            opt["cross_slope_deg"] = base.cross_slope_deg + value
+            dev["cross_slope"] = _symmetric_percentile(value, lo, hi)
         if "pushes" in f:
             opt["pushes"], dev["pushes"] = self._pushes(seed, h, seconds)
         return RobotDraw(seed, replace(base, **opt), dev)

@@ -25,6 +25,7 @@ FACTORS: dict[str, tuple[str, ...]] = {
     "accel_noise": ("sigma",),
     "servo_delay": ("min_s", "max_s"),
     "slope": ("min_deg", "max_deg"),
+    "cross_slope": ("min_deg", "max_deg"),
     "pushes": ("every_min_s", "every_max_s", "max_speed", "at_height_m"),
     "initial_twist": ("linear", "angular"),
 }

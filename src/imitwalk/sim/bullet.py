@@ -33,6 +33,7 @@ from imitwalk.sim.types import (
     ServoQueue,
     SimOptions,
     checked_targets,
+    gravity,
     jitter_draws,
     kicks_due,
 )
@@ -61,8 +62,7 @@ class BulletPlant:
         m = robot.compile()
         self.nq = m.nq
         self.client = c = pb.connect(pb.DIRECT)
-        th = np.deg2rad(opt.slope_deg)
-        self.gravity = 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+        self.gravity = gravity(opt)
         pb.setGravity(*self.gravity, physicsClientId=c)
         pb.setTimeStep(self.dt, physicsClientId=c)
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)

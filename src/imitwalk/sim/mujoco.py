@@ -31,6 +31,7 @@ from imitwalk.sim.types import (
     ServoQueue,
     SimOptions,
     checked_targets,
+    gravity,
     jitter_draws,
     kicks_due,
 )
@@ -82,8 +83,7 @@ class MujocoPlant:
         self.model = m = robot.compile()
         scale, kps = jitter_draws(opt, m.nbody, robot.joint_names)
         m.opt.timestep = 1.0 / opt.physics_hz
-        th = np.deg2rad(opt.slope_deg)
-        m.opt.gravity[:] = 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+        m.opt.gravity[:] = gravity(opt)
         if opt.friction is not None:
             m.geom_friction[:, 0] = opt.friction
         m.geom_friction[:, 0] *= opt.friction_scale

@@ -17,6 +17,7 @@ __all__ = [
     "ServoQueue",
     "SimOptions",
     "checked_targets",
+    "gravity",
     "jitter_draws",
     "kicks_due",
 ]
@@ -42,6 +43,8 @@ class SimOptions:
         mass_jitter: each body's mass also scaled by U(1 - j, 1 + j) (drawn from ``seed``).
         kp_scale: multiplies every servo stiffness; kp_jitter: per servo U(1 - j, 1 + j).
         slope_deg: ground slope [deg]; positive is uphill along +x (gravity tilted about y).
+        cross_slope_deg: the ground's slope across the walk [deg]: positive rises along +y,
+            to the robot's left at the start (gravity tilted about x as well).
         com_shift: ``(3,)`` the torso's centre of mass moved by this much in its own frame [m].
         pushes: velocity kicks ``(t [s], Δv_x, Δv_y [m/s])``, in time order: at the first
             physics step at or after ``t`` the whole robot's horizontal velocity changes by
@@ -65,6 +68,7 @@ class SimOptions:
     kp_scale: float = 1.0
     kp_jitter: float = 0.0
     slope_deg: float = 0.0
+    cross_slope_deg: float = 0.0
     com_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
     pushes: tuple[tuple[float, float, float], ...] = ()
     init_twist: tuple[float, ...] = (0.0,) * 6
@@ -112,6 +116,17 @@ def kicks_due(pushes, t: float, done: int) -> tuple[int, np.ndarray]:
         dv += np.asarray(pushes[done][1:3], dtype=float)
         done += 1
     return done, dv
+
+
+def gravity(opt: SimOptions) -> np.ndarray:
+    """``(3,)`` gravity [m/s²] in the world frame for ``opt``'s floor: tilted by
+    ``slope_deg`` about y and ``cross_slope_deg`` about x (the floor's normal is
+    ``(tan slope, tan cross, 1)`` normalised, and gravity points against it)."""
+    th = np.deg2rad(opt.slope_deg)
+    if opt.cross_slope_deg == 0.0:  # along the walk only, as before the cross slope existed
+        return 9.81 * np.array([-np.sin(th), 0.0, -np.cos(th)])
+    normal = np.array([np.tan(th), np.tan(np.deg2rad(opt.cross_slope_deg)), 1.0])
+    return -9.81 * normal / np.linalg.norm(normal)
 
 
 def checked_targets(targets, n: int) -> np.ndarray:
