@@ -91,6 +91,7 @@ def test_the_stepping_gait_walks_the_heading_and_stride_commanded(robot, stride)
     truth to a few centimetres."""
     from imitwalk.mocap import default_clip, load_motion
     from imitwalk.navigate.trial import truth_path
+    from imitwalk.sim.metrics import yaw_rad
     from imitwalk.sim.mujoco import make_plant, run
     from imitwalk.sim.types import SimOptions
     from imitwalk.step.controller import SteppingController
@@ -111,8 +112,7 @@ def test_the_stepping_gait_walks_the_heading_and_stride_commanded(robot, stride)
     policy.q0 = ctrl.q0
     ro = run(make_plant(robot, SimOptions()), policy, 800)
     assert not ro.fell
-    w, x, y, z = ro.torso_quat[-1]
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    yaw = yaw_rad(ro.torso_quat)[-1]
     assert 0.4 < yaw < 0.8 and abs(poses[-1].heading - 0.6) < 0.15
     path = truth_path(ro)
     travel = float(np.linalg.norm(path[-1]))

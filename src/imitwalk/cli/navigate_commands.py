@@ -39,23 +39,18 @@ def _fix(args: argparse.Namespace):
     return PositionFix(args.fix_rate, 0.05 if args.fix_noise is None else args.fix_noise)
 
 
-def _video(job, path: Path) -> Path:
-    """``job`` walked again and rendered to ``path`` (written beside, then renamed), the
-    course's waypoints drawn on the floor as discs of its reach."""
-    import numpy as np
-
-    from imitwalk.navigate.trial import walk_course
+def _video(job, result, path: Path) -> Path:
+    """``result``'s recorded walk (of ``job``) rendered to ``path`` (written beside, then
+    renamed), the course's waypoints drawn on the floor as discs of its reach."""
     from imitwalk.sim.render import render_frames, write_mp4
+    from imitwalk.step.odometry import rot2
 
-    _, _, ro = walk_course(job)
-    w, x, y, z = ro.torso_quat[0]  # the start frame, as the judge takes it
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    turn = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
-    marks = ro.torso_pos[0, :2] + job.course.waypoints @ turn.T
+    origin, yaw = result.start  # the start frame, as the judge takes it
+    marks = origin + job.course.waypoints @ rot2(yaw).T
     frames = render_frames(
         job.robot,
-        ro.qpos,
-        ro.control_dt,
+        result.qpos,
+        job.dt,
         30.0,
         distance=3.5,
         elevation=-50.0,
@@ -112,6 +107,7 @@ def navigate(args: argparse.Namespace) -> int:
             args.seconds,
             fix,
             gait.dt,
+            record=args.video and seed == 0,
         )
         for seed in range(args.seeds)
     ]
@@ -146,7 +142,7 @@ def navigate(args: argparse.Namespace) -> int:
     png = png_bytes(fig)
     atomic_write(out / "path.png", lambda tmp: tmp.write_bytes(png))
     if args.video:
-        summary["video"] = str(_video(jobs[0], out / "video.mp4"))
+        summary["video"] = str(_video(jobs[0], results[0], out / "video.mp4"))
     summary["plot"] = str(out / "path.png")
     text = json.dumps(summary, indent=2)
     atomic_write(out / "navigate.json", lambda tmp: tmp.write_text(text))

@@ -17,11 +17,13 @@ from imitwalk.navigate.course import Course
 from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.fix import FixSensor, PositionFix
+from imitwalk.sim.metrics import yaw_rad
 from imitwalk.sim.types import Rollout, SimOptions
 from imitwalk.step.gains import StepGains
+from imitwalk.step.odometry import rot2
 from imitwalk.step.style import GaitStyle
 
-__all__ = ["NavJob", "NavResult", "run_nav_job", "truth_path", "walk_course"]
+__all__ = ["NavJob", "NavResult", "run_nav_job", "start_frame", "truth_path", "walk_course"]
 
 #: A walk ends this long after the robot believes it reached the last waypoint [s].
 LINGER_S = 1.0
@@ -35,7 +37,8 @@ class NavJob:
         robot: the robot; style: the walk; gains: the stepping gait's gains; course: the
         waypoints; seed: the robot's seed in its protocol; options: its simulation;
         seconds: the most it may take [s]; fix: a position fix, or ``None`` (dead
-        reckoning); dt: the control period [s].
+        reckoning); dt: the control period [s]; record: keep the walk's ``qpos`` in the
+        result (for a video, so that the walk need not be simulated again).
     """
 
     robot: Robot
@@ -47,6 +50,7 @@ class NavJob:
     seconds: float
     fix: PositionFix | None = None
     dt: float = 0.01
+    record: bool = False
 
 
 @dataclass(frozen=True)
@@ -60,7 +64,9 @@ class NavResult:
         finish_s: when the last was reached [s] (``None``: not reached);
         odometry_error_m: the robot's own estimate of where it is, off the truth at the
         end [m]; path: ``(N, 2)`` the torso's true path [m]; estimate: ``(N, 2)`` the
-        robot's estimate [m], both in the start frame.
+        robot's estimate [m], both in the start frame; start: the frame's origin ``(2,)``
+        [m] and heading [rad] in the world (:func:`start_frame`); qpos: ``(N, nq)`` the
+        walk's states if the job asked to ``record`` them, else ``None``.
     """
 
     seed: int
@@ -72,6 +78,8 @@ class NavResult:
     odometry_error_m: float
     path: np.ndarray
     estimate: np.ndarray
+    start: tuple[np.ndarray, float]
+    qpos: np.ndarray | None = None
 
     @property
     def finished(self) -> bool:
@@ -92,14 +100,18 @@ class NavResult:
         }
 
 
+def start_frame(ro: Rollout) -> tuple[np.ndarray, float]:
+    """The start frame in the world: the torso's first position ``(2,)`` [m] on the floor
+    and its heading [rad]."""
+    return ro.torso_pos[0, :2].copy(), float(yaw_rad(ro.torso_quat[:1])[0])
+
+
 def truth_path(ro: Rollout) -> np.ndarray:
     """``(N, 2)`` the torso's path on the floor [m], in the frame of its first pose."""
     if len(ro.t) == 0:
         return np.zeros((0, 2))
-    w, x, y, z = ro.torso_quat[0]
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    c, s = np.cos(yaw), np.sin(yaw)
-    return (ro.torso_pos[:, :2] - ro.torso_pos[0, :2]) @ np.array([[c, -s], [s, c]])
+    origin, yaw = start_frame(ro)
+    return (ro.torso_pos[:, :2] - origin) @ rot2(yaw)
 
 
 def _reached(path: np.ndarray, t: np.ndarray, course: Course) -> list[float | None]:
@@ -153,6 +165,8 @@ def walk_course(job: NavJob):
         odometry_error_m=float(np.linalg.norm(est[-1] - path[-1])) if len(path) else 0.0,
         path=path,
         estimate=est,
+        start=start_frame(ro) if len(path) else (np.zeros(2), 0.0),
+        qpos=ro.qpos if job.record else None,
     )
     return result, nav, ro
 

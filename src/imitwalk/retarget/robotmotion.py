@@ -25,7 +25,7 @@ import mujoco
 import numpy as np
 
 from imitwalk.errors import MocapError
-from imitwalk.mocap.motion import Motion
+from imitwalk.mocap.motion import LOWER_BODY, Motion
 from imitwalk.robots import Robot
 
 __all__ = ["BALL", "MotionModel", "RobotMotion", "clip_of_motion", "motion_of_reference"]
@@ -218,20 +218,7 @@ def clip_of_motion(motion: RobotMotion, robot: Robot) -> Motion:
     jid = {r: m.joint(robot.mj_joints[robot.index(r)]).id for r in need}
     ball = BALL * leg_geometry(robot).foot_length
     t = motion.n_frames
-    keys = {
-        k: np.zeros((t, 3))
-        for k in (
-            "pelvis",
-            "l_hip",
-            "r_hip",
-            "l_knee",
-            "r_knee",
-            "l_ankle",
-            "r_ankle",
-            "l_toe",
-            "r_toe",
-        )
-    }
+    keys = {k: np.zeros((t, 3)) for k in LOWER_BODY}
     for k in range(t):
         kin.pose(motion.root_pos[k], motion.root_quat[k], motion.joints[k])
         keys["pelvis"][k] = d.xpos[kin.root]

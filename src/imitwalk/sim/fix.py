@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.errors import ConfigError
+from imitwalk.sim.metrics import yaw_rad
 
 __all__ = ["FixSensor", "PositionFix"]
 
@@ -51,8 +52,7 @@ class FixSensor:
         ``None``. The first call (at the start) sets the frame."""
         pos, quat = plant.torso_pose()
         if self._origin is None:
-            w, x, y, z = quat
-            yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+            yaw = float(yaw_rad(quat)[0])
             c, s = np.cos(yaw), np.sin(yaw)
             self._origin, self._rot = pos[:2].copy(), np.array([[c, s], [-s, c]])
             return None

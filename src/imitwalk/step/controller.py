@@ -115,7 +115,6 @@ class SteppingController:
     def steer(self, command: StepCommand) -> None:
         """Walk ``command`` from the next tick on (its stride rounded to a twentieth)."""
         self.command = command
-        self._stride = round(command.stride * 20) / 20
 
     @property
     def started(self) -> bool:
@@ -157,14 +156,13 @@ class SteppingController:
         self.odometry = LegOdometry()
         self.odometry.reset(e.swing.pos[:2], e.heading)
         self._com, self._heading = e.com[:2].copy(), e.heading
-        self.steer(self.command)
         self._started = True
 
     def _zmp_plan(self, e: BodyEstimate) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         """The planned ZMP now, the heel and toe points, and (in double support) the
         time left before lift-off."""
         side = 1.0 if self.stance == "l" else -1.0
-        gait = self.nominal.gait(self.steps + 1, self._stride)
+        gait = self.nominal.gait(self.steps + 1, self.command.stride)
         _, heel, toe = gait.zmp_points(side)
         if self.single:
             s = min(self.t_phase / max(self.ss, 1e-3), 1.0)
@@ -192,10 +190,10 @@ class SteppingController:
         e = self.est.update(obs, self.zmp)
         self._com, self._heading = e.com[:2], e.heading
         side = 1.0 if self.stance == "l" else -1.0
-        gait = self.nominal.gait(self.steps + 1, self._stride)
+        gait = self.nominal.gait(self.steps + 1, self.command.stride)
         zmp_plan, heel, toe, ds_left = self._zmp_plan(e)
         nominal = np.array([gait.step, -side * gait.width])
-        offset = self.nominal.offset(self.steps + 1, -side, self._stride)
+        offset = self.nominal.offset(self.steps + 1, -side, self.command.stride)
         if self.command.turn:  # a turning gait: the step and its DCM offset turn with it
             nominal, offset = turning_step(gait.step, gait.width, side, self.command.turn, offset)
         if self.single:

@@ -21,6 +21,7 @@ import numpy as np
 
 from imitwalk.step.gains import StepGains
 from imitwalk.step.lipm import NominalGait
+from imitwalk.step.odometry import rot2
 from imitwalk.step.planner import StepLimits, StepWeights
 from imitwalk.step.schedule import START_STEPS, stride_at
 from imitwalk.step.style import GaitStyle
@@ -65,7 +66,8 @@ class NominalWalk:
     def gait(self, step: int, stride: float = 1.0) -> NominalGait:
         """The periodic walk step ``step`` (counted from 1) is aimed at: the stride grows
         over :data:`~imitwalk.step.schedule.START_STEPS` steps to ``stride`` [0, 1] of
-        the style's."""
+        the style's (rounded to a twentieth: the walks are cached)."""
+        stride = round(stride * 20) / 20
         k = (min(step, START_STEPS), stride)
         if k not in self._gaits:
             st, g = self.style, self.gains
@@ -85,15 +87,11 @@ class NominalWalk:
     def offset(self, step: int, side: float, stride: float = 1.0) -> np.ndarray:
         """``(2,)`` the nominal DCM offset at touchdown [m] of step ``step``'s foot landing
         on ``side`` (+1 left, −1 right), at ``stride`` of the style's."""
+        stride = round(stride * 20) / 20
         key = (min(step, START_STEPS), side, stride)
         if key not in self._offsets:
             self._offsets[key] = self.gait(step, stride).offset(side)
         return self._offsets[key]
-
-
-def _rot2(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s], [s, c]])
 
 
 def turning_step(
@@ -105,5 +103,5 @@ def turning_step(
     and turns by ``turn``; each foot sits ``width / 2`` [m] beside it. ``side``: the stance
     foot's (+1 left); ``offset``: the straight walk's (:meth:`NominalWalk.offset`)."""
     half = 0.5 * width * side
-    land = _rot2(0.5 * turn) @ np.array([step, 0.0]) + _rot2(turn) @ np.array([0.0, -half])
-    return land - np.array([0.0, half]), _rot2(turn) @ offset
+    land = rot2(0.5 * turn) @ np.array([step, 0.0]) + rot2(turn) @ np.array([0.0, -half])
+    return land - np.array([0.0, half]), rot2(turn) @ offset

@@ -23,7 +23,7 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["LegOdometry", "Pose2D", "StepCommand"]
+__all__ = ["LegOdometry", "Pose2D", "StepCommand", "rot2"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,8 @@ class Pose2D:
         return np.array([self.x, self.y])
 
 
-def _rot(a: float) -> np.ndarray:
+def rot2(a: float) -> np.ndarray:
+    """``(2, 2)`` the rotation by ``a`` [rad] in the floor's plane."""
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, -s], [s, c]])
 
@@ -86,12 +87,12 @@ class LegOdometry:
     def reset(self, other_foot: np.ndarray, heading: float) -> None:
         """Start: ``other_foot`` ``(2,)`` [m] is the second sole in the stance frame, and
         the stance sole's heading is ``heading`` [rad]; the origin lies midway."""
-        self.foot = -0.5 * (_rot(heading) @ np.asarray(other_foot, dtype=float)[:2])
+        self.foot = -0.5 * (rot2(heading) @ np.asarray(other_foot, dtype=float)[:2])
 
     def touchdown(self, landing: np.ndarray, heading: float) -> None:
         """The swing foot landed at ``landing`` ``(2,)`` [m] in the frame of the stance
         foot, whose heading was ``heading`` [rad]; it becomes the stance foot."""
-        self.foot = self.foot + _rot(heading) @ np.asarray(landing, dtype=float)[:2]
+        self.foot = self.foot + rot2(heading) @ np.asarray(landing, dtype=float)[:2]
 
     def fix(self, measured: np.ndarray, body: np.ndarray, weight: float) -> None:
         """A position fix: the body is measured at ``measured`` ``(2,)`` [m] (start
@@ -102,5 +103,5 @@ class LegOdometry:
     def pose(self, com: np.ndarray, heading: float) -> Pose2D:
         """The body's pose: the centre of mass ``com`` ``(2,)`` [m] in the stance frame,
         the stance sole's ``heading`` [rad]."""
-        xy = self.foot + _rot(heading) @ np.asarray(com, dtype=float)[:2]
+        xy = self.foot + rot2(heading) @ np.asarray(com, dtype=float)[:2]
         return Pose2D(float(xy[0]), float(xy[1]), float(heading))
