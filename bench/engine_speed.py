@@ -1,8 +1,8 @@
 """MuJoCo and Bullet side by side: wall time per simulated second of open-loop playback
-of the same reference on the same robot (settings interleaved, the best of three kept),
-and how closely the two engines agree on it.
+of the same reference on the same robot (settings interleaved, the best of ``--repeat``
+kept), and how closely the two engines agree on it.
 
-Usage: ``python bench/engine_speed.py [--seconds 10] [--scale 0.3]``
+Usage: ``python bench/engine_speed.py [--seconds 10] [--scale 0.3] [--repeat 3]``
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=10.0)
     ap.add_argument("--scale", type=float, default=0.3)
+    ap.add_argument("--repeat", type=int, default=3, help="trials; the best is kept")
     args = ap.parse_args()
     robot = load_robot("hoap2")
     cfg = RetargetConfig(search=False, scales=(args.scale,), params=GaitParams(sway=0.9, ds=0.1))
@@ -30,7 +31,7 @@ def main() -> None:
     q = ref.trajectory(args.scale, args.seconds)
     best = {"mujoco": np.inf, "bullet": np.inf}
     runs = {}
-    for engine in ("mujoco", "bullet") * 3:
+    for engine in ("mujoco", "bullet") * args.repeat:
         plant = make_plant(robot, None, engine)
         t0 = time.perf_counter()
         ro = playback(plant, q, q0=q[0], stop_on_fall=False)

@@ -20,7 +20,7 @@ from imitwalk.sim.mujoco import make_plant, run
 
 def measure(path: str, seconds: float) -> dict:
     lr = load_run(path)
-    robot = load_robot(lr.ref.settings.get("robot") or "hoap2", lr.ref.settings.get("joint_map"))
+    robot = load_robot(lr.ref.provenance.robot or "hoap2", lr.ref.provenance.joint_map)
     gait, st = lr.ref, lr.ref.style
     ro = run(
         make_plant(robot, gait.sim_options()),

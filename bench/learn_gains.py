@@ -20,9 +20,9 @@ from __future__ import annotations
 import argparse
 import json
 
-from imitwalk.judge.protocol import load_protocol
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.robots import load_robot
+from imitwalk.sim.protocol import load_protocol
 from imitwalk.step.gains import BOUNDS, StepGains
 from imitwalk.step.learn import StepLearnConfig, learn_step
 from imitwalk.step.pipeline import gait_from_motion

@@ -15,11 +15,11 @@ from __future__ import annotations
 import argparse
 import json
 
-from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.replay import load_run
 from imitwalk.judge.verdict import judge_protocol
 from imitwalk.paper.evaluate import compare_falls
 from imitwalk.robots import load_robot
+from imitwalk.sim.protocol import load_protocol
 
 
 def main() -> None:
@@ -35,9 +35,7 @@ def main() -> None:
     for item in args.runs:
         path, _, controller = item.rpartition(":")
         lr = load_run(path)
-        robot = load_robot(
-            lr.ref.settings.get("robot") or "hoap2", lr.ref.settings.get("joint_map")
-        )
+        robot = load_robot(lr.ref.provenance.robot or "hoap2", lr.ref.provenance.joint_map)
         v = judge_protocol(
             path, robot, protocol, args.seeds, args.seconds, (controller,), first=args.first
         )

@@ -1,8 +1,8 @@
 """Batch evaluation on 2 cores: ``mujoco.rollout`` with 1 and 2 threads, and imitwalk's
 process pool with 1 and 2 workers, on the same open-loop playbacks (same run; the
-settings are interleaved and the best of two kept for each).
+settings are interleaved and the best of ``--repeat`` kept for each).
 
-Usage: ``python bench/parallel_speedup.py [--models 8] [--seconds 10]``
+Usage: ``python bench/parallel_speedup.py [--models 8] [--seconds 10] [--repeat 2]``
 """
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ from mujoco import rollout
 
 from imitwalk.mocap import default_clip, load_motion
 from imitwalk.retarget import GaitParams, RetargetConfig, retarget
+from imitwalk.retarget.playback import play_reference
 from imitwalk.robots import load_robot
 from imitwalk.sim.mujoco import MujocoPlant
 from imitwalk.sim.perturb import perturbed
-from imitwalk.sim.playback import play_reference
 
 
 def _models(robot, n: int):
@@ -37,6 +37,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--models", type=int, default=8)
     ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument("--repeat", type=int, default=2, help="trials; the best is kept")
     args = ap.parse_args()
     robot = load_robot("hoap2")
     cfg = RetargetConfig(search=False, scales=(0.5,), params=GaitParams())
@@ -56,7 +57,7 @@ def main() -> None:
         states.append(st)
     models = [p.model for p in plants]
     out = {"models": args.models, "sim_seconds_each": args.seconds}
-    for threads in (1, 2, 1, 2):  # interleaved, best of two each
+    for threads in (1, 2) * args.repeat:  # interleaved, best of --repeat each
         datas = [mujoco.MjData(models[0]) for _ in range(threads)]
         t = time.perf_counter()
         rollout.rollout(models, datas, np.array(states), ctrl, persistent_pool=False)
@@ -64,7 +65,7 @@ def main() -> None:
         key = f"rollout_{threads}_threads_s"
         out[key] = min(out.get(key, dt), dt)
     out["rollout_speedup"] = round(out["rollout_1_threads_s"] / out["rollout_2_threads_s"], 2)
-    for workers in (1, 2, 1, 2):
+    for workers in (1, 2) * args.repeat:
         t = time.perf_counter()
         play_reference(ref, robot, 0.5, args.seconds, list(range(args.models)), workers=workers)
         dt = round(time.perf_counter() - t, 3)

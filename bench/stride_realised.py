@@ -33,7 +33,7 @@ def main() -> None:
     ap.add_argument("--robot", default=None)
     a = ap.parse_args()
     ref = Reference.load(a.reference)
-    robot = load_robot(a.robot or ref.settings.get("robot") or ref.robot)
+    robot = load_robot(a.robot or ref.provenance.robot or ref.robot)
     q = ref.trajectory(a.scale, a.seconds)
     plant = make_plant(robot, ref.sim_options())
     ro = playback(plant, q, q0=q[0])

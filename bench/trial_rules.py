@@ -22,10 +22,10 @@ import numpy as np
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickrun import TickJob, run_tick_episode
 from imitwalk.balance.tickstore import feedback_law
-from imitwalk.judge.protocol import load_protocol
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import load_robot
+from imitwalk.sim.protocol import load_protocol
 
 #: (pitch, roll, heading) gains: the coordinate search's path and its neighbours.
 LAWS = (

@@ -17,11 +17,11 @@ import json
 
 import numpy as np
 
-from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.replay import load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.robots import load_robot
 from imitwalk.sim.metrics import yaw_rad
+from imitwalk.sim.protocol import load_protocol
 from imitwalk.step.episode import StepJob, walk_step
 
 
@@ -47,7 +47,7 @@ def main() -> None:
     a = ap.parse_args()
     lr = load_run(a.run)
     gait = lr.step_gait
-    robot = load_robot(gait.settings.get("robot") or gait.robot, gait.settings.get("joint_map"))
+    robot = load_robot(gait.provenance.robot or gait.robot, gait.provenance.joint_map)
     style, gains = gait.at_scale(lr.scale), lr.step_gains["learned"]
     protocol = load_protocol(a.protocol)
     jobs = [

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from file_fuzz import SUMMARY
 from imitwalk import __version__
 from imitwalk.cli.main import main
+from tests.helpers.fuzz_files import SUMMARY
 
 HOAP2 = Path(__file__).resolve().parents[1] / "src" / "imitwalk" / "robots" / "hoap2"
 C3D, AMC, ASF = "c3d/treadmill_events.c3d", "cmu_asf_amc/test.amc", "cmu_asf_amc/test.asf"

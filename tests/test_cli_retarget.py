@@ -10,7 +10,7 @@ import pytest
 
 from imitwalk.cli.main import main
 from imitwalk.mocap.vicon import read_c3d
-from test_mocap_c3d import C3D, PIG_MARKERS, _cols, write_c3d
+from tests.test_mocap_c3d import C3D, PIG_MARKERS, _cols, write_c3d
 
 
 def _fails_in_one_line(capsys, argv, out, match):

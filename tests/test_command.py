@@ -134,7 +134,7 @@ def test_a_turning_reference_is_solved_and_saved(turning, tmp_path):
     assert turning.residual_mm.max() < 1.0  # the IK reaches the turned soles
     path = turning.save(tmp_path / "turn.npz")
     back = Reference.load(path)
-    assert back.gait_command() == GaitCommand(turn_deg=10.0)
+    assert back.command == GaitCommand(turn_deg=10.0)
     np.testing.assert_array_equal(back.motion, turning.motion)
     tr = back.track(0.5, 20.0)
     per_cycle = back.motion_at(0.5)[2]
@@ -151,7 +151,7 @@ def test_a_reference_from_before_commands_reads_as_straight(tiny_reference):
             **ref.__dict__,
             "plan": {k: v for k, v in ref.plan.items() if k not in ("yaw", "path")},
             "motion": np.zeros((0, 5)),
-            "command": {},
+            "command": GaitCommand(),
         }
     )
     plan = old.plan_at(0.35)
@@ -187,7 +187,7 @@ def test_metrics_measure_a_turn_against_its_command():
 
 
 def test_a_turning_reference_turns_on_the_robot(robot, turning):
-    from imitwalk.sim.playback import play_reference
+    from imitwalk.retarget.playback import play_reference
 
     runs = play_reference(turning, robot, 0.5, 10.0, seeds=[0, 1], workers=1)
     for r in runs:
@@ -212,7 +212,7 @@ def test_cli_retarget_turn_and_bad_commands(tmp_path, capsys):
     argv = ["retarget", "--out", str(out), "--no-search", "--set", "scales=[0.5]"]
     assert main([*argv, "--turn", "8", "--forward", "0.5", "--json"]) == 0
     capsys.readouterr()
-    assert Reference.load(out).gait_command() == GaitCommand(turn_deg=8.0, forward=0.5)
+    assert Reference.load(out).command == GaitCommand(turn_deg=8.0, forward=0.5)
     assert (
         main(["playback", str(out), "--scale", "0.5", "--seconds", "2", "--models", "1", "--json"])
         == 0
@@ -279,12 +279,12 @@ def test_the_learner_sees_heading_beyond_the_commanded_turn(robot, turning):
 @pytest.mark.slow
 def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     """The whole loop on a turning reference: learned, evaluated against its own path."""
-    from conftest import TICK
     from imitwalk.balance.tickconfig import TickLearnConfig
     from imitwalk.balance.ticklearn import learn_tick
     from imitwalk.config import apply_overrides
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import JudgeJob, run_controller
+    from imitwalk.sim.protocol import load_protocol
+    from tests.conftest import TICK
 
     cmd = GaitCommand(turn_deg=12.0)
     ref = build_walkable(template, robot, GaitParams(), [0.3, 0.4], 0.01, command=cmd).reference

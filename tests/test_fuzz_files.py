@@ -1,5 +1,5 @@
-"""Fuzzing what imitwalk reads back and writes (``file_fuzz``, issue 60): reference
-``.npz`` files, run-folder files and output paths.
+"""Fuzzing what imitwalk reads back and writes (:mod:`tests.helpers.fuzz_files`, issue
+60): reference ``.npz`` files, run-folder files and output paths.
 
 Each case must end in a one-line project error (:class:`~imitwalk.errors.ImitwalkError`)
 or in a usable result (a reference that plays, a run file read as its record, an output
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from file_fuzz import INPUTS, OUTCOMES, fuzz, make_case
 from imitwalk.cli.main import main
+from tests.helpers.fuzz_files import INPUTS, OUTCOMES, fuzz, make_case
 
 DEFAULT_CASES = 300
 SLOW_CASES = 2000

@@ -1,10 +1,12 @@
-"""Fuzzing the mocap readers with seeded mutations of the real files (``mocap_fuzz``).
+"""Fuzzing the mocap readers with seeded mutations of the real files
+(:mod:`tests.helpers.fuzz_mocap`).
 
 Each case must end in a project error (:class:`~imitwalk.errors.ImitwalkError`) or in a
 Motion that is finite and within the bounds of :mod:`imitwalk.mocap.bounds`, within a
 time limit: any other exception, an implausible result or a hang fails the test. The
 default run does :data:`DEFAULT_CASES` per format; ``-m slow`` does :data:`SLOW_CASES`
-(the figures in BENCHMARKS.md come from ``bench/fuzz_mocap.py``, the same cases).
+(the figures in BENCHMARKS.md come from its command line, ``python -m
+tests.helpers.fuzz_mocap``, the same cases).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from mocap_fuzz import FORMATS, make_case, run_case, seeds
+from tests.helpers.fuzz_mocap import FORMATS, make_case, run_case, seeds
 
 DEFAULT_CASES = 250
 SLOW_CASES = 2000
@@ -50,12 +52,12 @@ def test_fuzz_slow(shared_mocap, tmp_path, fmt):
 
 def test_a_hang_is_caught(tmp_path, monkeypatch):
     """The time limit interrupts a reader that never returns."""
-    import mocap_fuzz
+    from tests.helpers import fuzz_mocap
 
     def forever(path):
         while True:
             pass
 
-    monkeypatch.setattr(mocap_fuzz, "load_motion", forever)
-    case = mocap_fuzz.Case({"x.bvh": b""}, "x.bvh", "none")
+    monkeypatch.setattr(fuzz_mocap, "load_motion", forever)
+    case = fuzz_mocap.Case({"x.bvh": b""}, "x.bvh", "none")
     assert run_case(case, tmp_path, 0.2) == ("hang", "> 0.2 s")

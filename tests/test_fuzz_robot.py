@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from robot_fuzz import OUTCOMES, cases, fuzz
+from tests.helpers.fuzz_robot import OUTCOMES, cases, fuzz
 
 #: Cases of the default run (half per input) and of the slow one (2,000 per input).
 DEFAULT, SLOW = 300, 4000

@@ -187,7 +187,7 @@ def test_op3_reference_adapts_to_its_legs(drafted, capsys):
     assert geom.leg == pytest.approx(0.22, abs=0.005) and geom.hip_y == pytest.approx(0.054)
     cfg = RetargetConfig(search=False, scales=(0.5,))
     ref = retarget(load_motion(default_clip()), r, cfg).reference
-    assert ref.params["lift"] == pytest.approx(0.1 * geom.leg, abs=1e-6)
+    assert ref.params.lift == pytest.approx(0.1 * geom.leg, abs=1e-6)
     assert bounds(geom.leg)["lift"] == pytest.approx((0.075 * geom.leg, 0.225 * geom.leg), abs=1e-6)
     assert ref.residual_mm.max() < 5.0 and ref.checks["feet_alternate"]
     q = ref.trajectory(0.5, 2.0)
@@ -226,8 +226,8 @@ def test_a_run_finds_its_robot_file(tiny_reference, tmp_path):
     from imitwalk.runs import RunDir
 
     ref, _ = tiny_reference  # shared: a copy with other settings
-    settings = {**ref.settings, "robot": "/robots/op3.json", "joint_map": None}
-    replace(ref, settings=settings).save(tmp_path / "reference.npz")
+    made = ref.provenance.named("/robots/op3.json", None)
+    replace(ref, provenance=made).save(tmp_path / "reference.npz")
     (tmp_path / "config.json").write_text(json.dumps({"robot": "op3"}))
     assert run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/robots/op3.json", None)
 

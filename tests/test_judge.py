@@ -7,10 +7,10 @@ import json
 import pytest
 
 from imitwalk.errors import ConfigError
-from imitwalk.judge.protocol import load_protocol
 from imitwalk.judge.records import ProtocolVerdict
 from imitwalk.judge.verdict import judge_protocol
 from imitwalk.paper.evaluate import compare_falls
+from imitwalk.sim.protocol import load_protocol
 
 #: Robots and seconds of the judgement (the hard protocol, where robots fall).
 SEEDS, SECONDS = 3, 6.0

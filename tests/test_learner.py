@@ -8,17 +8,17 @@ import json
 import numpy as np
 import pytest
 
-from conftest import TINY, sets, strip_log, strip_wall
 from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
-from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.paper.learner import learn
 from imitwalk.runs import RunDir
+from tests.conftest import TINY, sets, strip_log, strip_wall
 
 
 def test_same_seed_same_result(tmp_path, robot, tiny_reference):
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset("faithful"), [*TINY, "train_models=2"])
+    cfg = apply_overrides(LearnConfig(), [*TINY, "train_models=2"])
     a = learn(ref, robot, cfg, tmp_path / "a")
     b = learn(ref, robot, cfg, tmp_path / "b")
     assert strip_wall(a) == strip_wall(b)
@@ -28,7 +28,7 @@ def test_same_seed_same_result(tmp_path, robot, tiny_reference):
 
 def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference):
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset("faithful"), [*TINY, "train_models=2"])
+    cfg = apply_overrides(LearnConfig(), [*TINY, "train_models=2"])
     whole = learn(ref, robot, cfg, tmp_path / "whole")
     calls = []
 
@@ -54,7 +54,8 @@ def test_interrupted_run_resumes_to_the_same_end(tmp_path, robot, tiny_reference
 
 
 def test_training_robot_draws_never_overlap_or_meet_an_evaluation_robot():
-    from imitwalk.sim.perturb import TRAIN_SEED_BASE, train_seeds
+    from imitwalk.sim.perturb import train_seeds
+    from imitwalk.sim.seeds import TRAIN_SEED_BASE
 
     draws = [train_seeds(6, d) for d in range(50)]
     assert draws[0] == (0, 1001, 1002, 1003, 1004, 1005)
@@ -64,7 +65,7 @@ def test_training_robot_draws_never_overlap_or_meet_an_evaluation_robot():
 
 def test_run_folder_contents(tmp_path, robot, tiny_reference):
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset("faithful"), TINY)
+    cfg = apply_overrides(LearnConfig(), TINY)
     summary = learn(ref, robot, cfg, tmp_path / "run")
     rd = RunDir(tmp_path / "run")
     for name in (
@@ -99,7 +100,7 @@ def test_refuses_to_overwrite_and_to_resume_nothing(tmp_path, robot, tiny_refere
     from imitwalk.errors import RunError
 
     ref, _ = tiny_reference
-    cfg = apply_overrides(preset("faithful"), [*TINY, "schedule.stop=0.3", "schedule.iterations=1"])
+    cfg = apply_overrides(LearnConfig(), [*TINY, "schedule.stop=0.3", "schedule.iterations=1"])
     with pytest.raises(RunError, match="nothing to resume"):
         learn(ref, robot, cfg, tmp_path / "x", resume=True)
     learn(ref, robot, cfg, tmp_path / "x")
@@ -174,7 +175,7 @@ def test_a_short_faithful_run_lowers_the_measured_gyro_cost(tmp_path, robot, tin
 
     ref, _ = tiny_reference
     cfg = apply_overrides(
-        preset("faithful"),
+        LearnConfig(),
         ["schedule.stop=0.3", "schedule.iterations=3", "schedule.seconds=8", "workers=1"],
     )
     learn(ref, robot, cfg, tmp_path / "run")

@@ -20,13 +20,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from bvh_writer import M_Z_UP, load_rig, write_bvh
 from imitwalk.cli.main import main
 from imitwalk.errors import MocapError
 from imitwalk.mocap import LOWER_BODY, load_motion
 from imitwalk.mocap._common import UP_AXES, UP_TO_Z_UP
 from imitwalk.mocap.bvh import UNITS, read_bvh
 from imitwalk.retarget.template import extract_template
+from tests.helpers.bvh_writer import M_Z_UP, load_rig, write_bvh
 
 SRC = "cmu_bvh/07_06.bvh"
 CMU = UNITS["cmu"]

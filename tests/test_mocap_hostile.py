@@ -20,7 +20,7 @@ from imitwalk.errors import MocapError, MocapWarning
 from imitwalk.mocap import load_motion
 from imitwalk.mocap.amc import read_amc
 from imitwalk.mocap.bounds import FPS_RANGE, LEG_RANGE_M
-from test_cli_retarget import _fails_in_one_line
+from tests.test_cli_retarget import _fails_in_one_line
 
 BVH = "cmu_bvh/07_04.bvh"
 ASF, AMC = "cmu_asf_amc/test.asf", "cmu_asf_amc/test.amc"

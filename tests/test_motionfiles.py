@@ -151,9 +151,9 @@ def test_a_robot_motion_gives_the_stepping_gait_the_clips_style(walk, robot, tin
 
 
 def test_learn_reads_a_gmr_file_as_its_clip(walk, robot, tmp_path, capsys):
-    from conftest import TINY_STEP, sets
     from imitwalk.cli import main
     from imitwalk.retarget.motionfiles import write_gmr
+    from tests.conftest import TINY_STEP, sets
 
     path = write_gmr(walk, robot, tmp_path / "walk.pkl")
     assert main(["learn", str(path), "--out", str(tmp_path / "run"), *sets(TINY_STEP)]) == 0

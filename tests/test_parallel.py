@@ -147,7 +147,7 @@ def test_ray_executor_runs_a_playback_sweep(monkeypatch, tiny_reference, robot):
     pytest.importorskip("ray")
     import ray
 
-    from imitwalk.sim.playback import play_reference
+    from imitwalk.retarget.playback import play_reference
 
     ref, _ = tiny_reference
     local = play_reference(ref, robot, 0.3, 2.0, [0, 1], workers=1)

@@ -7,9 +7,9 @@ import json
 
 import pytest
 
-from conftest import TICK, sets
 from imitwalk.balance.tickconfig import LqrConfig, TrialConfig
 from imitwalk.cli.main import main
+from tests.conftest import TICK, sets
 
 #: A small reference search.
 SEARCH = [

@@ -1,4 +1,4 @@
-"""The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.balance.refchoice`):
+"""The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.learning.refchoice`):
 the rule that keeps a pass, the walker the second search plays its candidates with, and
 the run folder the whole choice writes and resumes."""
 
@@ -13,8 +13,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conftest import sets
-from imitwalk.balance.refchoice import (
+from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.cli.main import main
+from imitwalk.config import apply_overrides
+from imitwalk.errors import ConfigError
+from imitwalk.learning.refchoice import (
     PASSES,
     Choice,
     PassVerdict,
@@ -23,14 +26,11 @@ from imitwalk.balance.refchoice import (
     pick,
     same_gait,
 )
-from imitwalk.balance.tickconfig import TickLearnConfig
-from imitwalk.cli.main import main
-from imitwalk.config import apply_overrides
-from imitwalk.errors import ConfigError
 from imitwalk.retarget import Reference
 from imitwalk.retarget.search import SearchConfig, search_params
 from imitwalk.retarget.template import extract_template
 from imitwalk.runs import RunDir
+from tests.conftest import sets
 
 
 def _verdict(name: str, scale=1.0, falls=0, progress=0.9) -> PassVerdict:
@@ -87,7 +87,7 @@ def test_same_gait_looks_at_the_gait_not_the_search_report(tick_reference):
     loops = ref.loops.copy()
     loops[-1, 0, 0] += 1e-6
     assert not same_gait(ref, replace(ref, loops=loops))
-    assert not same_gait(ref, replace(ref, params={**ref.params, "sway": -1.0}))
+    assert not same_gait(ref, replace(ref, params=replace(ref.params, sway=-1.0)))
 
 
 def test_a_second_search_that_keeps_the_first_gait_is_not_learned_again(
@@ -134,9 +134,9 @@ def test_the_search_scores_the_walkers_walks(robot):
         generations=1, population=1, elites=1, scales=(0.5,), models=2, seconds=2.0, workers=1
     )
     _, rep = search_params(template, robot, cfg, walker=_stub_walker)
-    assert rep["best"]["score"] == pytest.approx(0.5 + 0.5 * 0.4 - 0.5 * 9 / 45)
-    assert [r["fell"] for r in rep["best"]["runs"]] == [True, True]
-    assert "learned law" in rep["method"]
+    assert rep.best_score == pytest.approx(0.5 + 0.5 * 0.4 - 0.5 * 9 / 45)
+    assert [r["fell"] for r in rep.best["runs"]] == [True, True]
+    assert "learned law" in rep.method
 
 
 QUICK_SEARCH = [
@@ -185,7 +185,7 @@ def test_learn_a_clip_learns_both_references_and_keeps_the_better(tmp_path, caps
         if (out / kept / name).exists():
             assert (out / name).read_bytes() == (out / kept / name).read_bytes(), name
             assert (out / name).samefile(out / kept / name), name  # linked, not stored twice
-    assert "learned law" in Reference.load(out / "closed" / "reference.npz").search["method"]
+    assert "learned law" in Reference.load(out / "closed" / "reference.npz").search.method
     config = json.loads((out / "config.json").read_text())
     assert config["learn"]["choice"] == {"robots": 2, "seconds": 5.0, "first": 1001}
     walker = law_walker(out / PASSES[0])

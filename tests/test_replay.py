@@ -5,21 +5,21 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import TINY
 from imitwalk.balance.feedback import TickPolicy
 from imitwalk.config import apply_overrides
 from imitwalk.errors import ConfigError, RunError
 from imitwalk.judge.replay import OPEN_LOOP, load_run
-from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.paper.learner import learn
 from imitwalk.paper.policy import WalkPolicy
 from imitwalk.runs import RunDir
+from tests.conftest import TINY
 
 
 @pytest.fixture(scope="module")
 def faithful_run(robot, tiny_reference, tmp_path_factory):
     out = tmp_path_factory.mktemp("faithful") / "run"
-    learn(tiny_reference[0], robot, apply_overrides(preset("faithful"), TINY), out)
+    learn(tiny_reference[0], robot, apply_overrides(LearnConfig(), TINY), out)
     return out
 
 

@@ -6,19 +6,20 @@ from __future__ import annotations
 import os
 import re
 import shutil
+from dataclasses import replace
 
 import pytest
 
-from conftest import TINY, _missing
 from imitwalk.cli.main import main
 from imitwalk.config import apply_overrides
 from imitwalk.evidence.report import write_report
 from imitwalk.judge import pushes
 from imitwalk.judge.replay import load_run
-from imitwalk.paper.learnconfig import preset
+from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.paper.learner import learn
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import RunDir
+from tests.conftest import TINY, _missing
 
 #: Flags for a quiet, offline headless Chromium (Playwright adds a fresh profile).
 CHROMIUM_ARGS = [
@@ -86,8 +87,7 @@ def bare_report(run_dir, robot, tmp_path_factory):
         ),
     )
     ref = Reference.load(bare / "reference.npz")
-    ref.source = str(bare / "no_such_clip.bvh")
-    ref.save(bare / "reference.npz")
+    replace(ref, source=str(bare / "no_such_clip.bvh")).save(bare / "reference.npz")
     return write_report(bare, robot, seconds=2.0), None
 
 
@@ -150,7 +150,7 @@ def test_figures_take_empty_data(run_dir):
 def test_a_faithful_run_has_a_report(robot, tiny_reference, tmp_path):
     ref, _ = tiny_reference
     out = tmp_path / "run"
-    learn(ref, robot, apply_overrides(preset("faithful"), TINY), out)
+    learn(ref, robot, apply_overrides(LearnConfig(), TINY), out)
     text = write_report(out, robot, seconds=2.0).read_text()
     assert "faithful learner" in text and "Fig. 6" in text
     assert text.count("data:video/mp4;base64,") == 1

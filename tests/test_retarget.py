@@ -107,8 +107,7 @@ def test_walkable_reference_of_cmu_walks(shared_mocap, robot, clip):
 
 
 def test_reference_round_trip_and_access(tmp_path, built):
-    ref = built.reference
-    ref.source = "x.bvh"
+    ref = dataclasses.replace(built.reference, source="x.bvh")
     path = ref.save(tmp_path / "ref.npz")
     back = Reference.load(path)
     for f in dataclasses.fields(Reference):
@@ -136,9 +135,9 @@ def test_search_is_small_deterministic_and_reported(robot, template):
     )
     p1, rep1 = search_params(template, robot, cfg)
     p2, rep2 = search_params(template, robot, cfg)
-    assert p1 == p2 and rep1["best"]["score"] == rep2["best"]["score"]
-    assert rep1["evaluations"] == 2 and len(rep1["history"]) == 2
-    assert set(rep1["best"]["params"]) == {"sway", "height", "lift", "ds", "lean", "width"}
+    assert p1 == p2 and rep1.best_score == rep2.best_score
+    assert rep1.evaluations == 2 and len(rep1.history) == 2
+    assert set(rep1.best["params"]) == {"sway", "height", "lift", "ds", "lean", "width"}
 
 
 def test_paper_mapping_builds_and_reports_clipping(robot):

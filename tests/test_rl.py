@@ -51,10 +51,10 @@ def test_a_run_holds_what_the_judge_needs(residual_run):
 
 
 def test_the_judge_plays_the_policy_beside_the_stepping_gait(residual_run):
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.replay import load_run
     from imitwalk.judge.verdict import judge_protocol
     from imitwalk.robots import load_robot
+    from imitwalk.sim.protocol import load_protocol
 
     loaded = load_run(residual_run)
     assert loaded.controllers() == ("rl", "default")

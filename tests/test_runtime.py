@@ -40,11 +40,11 @@ def _through_runtime(export, step_run, robot, protocol: str, seeds: int, seconds
     """Each of the protocol's first ``seeds`` robots walked by the exported controller,
     handed nothing but the sensor vector: ``[(fell, fall time, distance)]``. The run
     folder only sets up the plant and the metrics, as the judge does."""
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.replay import load_run
     from imitwalk.runtime import Controller
     from imitwalk.sim.metrics import walk_metrics
     from imitwalk.sim.mujoco import make_plant, run
+    from imitwalk.sim.protocol import load_protocol
 
     proto = load_protocol(protocol)
     gait = load_run(step_run).step_gait
@@ -70,8 +70,8 @@ def _through_runtime(export, step_run, robot, protocol: str, seeds: int, seconds
 
 
 def _judged(step_run, robot, protocol: str, seeds: int, seconds: float):
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.sim.protocol import load_protocol
 
     v = judge_protocol(
         str(step_run), robot, load_protocol(protocol), seeds, seconds, ("learned",), workers=1

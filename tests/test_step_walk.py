@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import TINY_STEP, sets, strip_wall
+from tests.conftest import TINY_STEP, sets, strip_wall
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +67,7 @@ def test_the_gait_saves_and_loads(gait, tmp_path):
 def test_learning_resumes_exactly(robot, gait, tmp_path):
     """Two generations straight, and one, interrupted, then resumed: the same gains."""
     from imitwalk.config import apply_overrides
-    from imitwalk.judge.protocol import load_protocol
+    from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
     from imitwalk.step.pipeline import learn_clip
 
@@ -156,7 +156,7 @@ def test_a_stepping_run_names_the_robot_file_it_learned_on(gait, tmp_path):
     from imitwalk.cli.robot_args import run_robot
     from imitwalk.runs import RunDir
 
-    replace(gait, settings={"robot": "/x/op3.json", "joint_map": None}).save(
+    replace(gait, provenance=gait.provenance.named("/x/op3.json", None)).save(
         tmp_path / "style.json"
     )
     assert run_robot(RunDir(tmp_path), {"robot": "op3"}) == ("/x/op3.json", None)

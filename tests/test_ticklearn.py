@@ -8,7 +8,6 @@ import json
 import numpy as np
 import pytest
 
-from conftest import TICK, sets, strip_log, strip_wall
 from imitwalk.balance.feedback import FeedbackLaw
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.ticklearn import learn_tick
@@ -18,6 +17,7 @@ from imitwalk.config import apply_overrides
 from imitwalk.errors import RunError
 from imitwalk.retarget import Reference
 from imitwalk.runs import RunDir
+from tests.conftest import TICK, sets, strip_log, strip_wall
 
 
 def _config(extra=()) -> TickLearnConfig:

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import TINY_STEP, sets
+from tests.conftest import TINY_STEP, sets
 
 
 def _walker(name: str) -> Path:

@@ -17,6 +17,7 @@ MuJoCo)::
 from __future__ import annotations
 
 import os
+from typing import Any
 
 # Offscreen rendering on the CPU: MuJoCo reads MUJOCO_GL when it is first imported.
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -52,7 +53,7 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "SteppingController": "imitwalk.step.controller",
     "TickLearnConfig": "imitwalk.balance.tickconfig",
     "learn_tick": "imitwalk.balance.ticklearn",
-    "learn_clip": "imitwalk.balance.refchoice",
+    "learn_clip": "imitwalk.learning.refchoice",
     "load_run": "imitwalk.judge.replay",
     "evaluate_run": ("imitwalk.judge.verdict", "judge_protocol"),
     "Plant": "imitwalk.sim.mujoco",
@@ -60,7 +61,7 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "make_plant": "imitwalk.sim.mujoco",
     "run": "imitwalk.sim.mujoco",
     "load_laws": "imitwalk.balance.tickstore",
-    "load_protocol": "imitwalk.judge.protocol",
+    "load_protocol": "imitwalk.sim.protocol",
     "judge_protocol": "imitwalk.judge.verdict",
     "push_recovery": "imitwalk.judge.pushes",
     "LearnSummary": "imitwalk.runs",
@@ -75,7 +76,7 @@ _LAZY: dict[str, str | tuple[str, str]] = {
 }
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     if name in _LAZY:
         import importlib
 

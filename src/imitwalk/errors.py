@@ -54,7 +54,9 @@ class SensorError(ImitwalkError):
     that is not finite."""
 
 
-def unknown_name(kind: str, name: str, valid: Iterable[str], cls: type[ImitwalkError] = RobotError):
+def unknown_name(
+    kind: str, name: str, valid: Iterable[str], cls: type[ImitwalkError] = RobotError
+) -> ImitwalkError:
     """Build an error for an unknown name that lists the valid choices.
 
     >>> str(unknown_name("joint", "kneee", ["knee", "hip"]))

@@ -21,11 +21,15 @@ import multiprocessing
 import os
 import signal
 import threading
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from imitwalk.errors import ConfigError, unknown_name
+
+if TYPE_CHECKING:
+    import ctypes
 
 __all__ = ["EXECUTORS", "abandoned", "run_parallel"]
 
@@ -33,7 +37,7 @@ EXECUTORS = ("process", "ray")
 
 #: In a pool's worker: its map's shared flag, set to 1 once ``stop`` has held (``None``
 #: elsewhere). A lock-free byte, since a job may read it every tick.
-_ABANDONED = None
+_ABANDONED: ctypes.c_byte | None = None
 
 
 def abandoned() -> bool:
@@ -84,7 +88,8 @@ def run_parallel(
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
 
-    def in_order():  # each next job is started only once the result before is taken
+    # each next job is started only once the result before is taken
+    def in_order() -> Iterator[Future]:
         for k in range(len(jobs)):
             yield futures[k]
             if len(futures) < len(jobs):
@@ -109,7 +114,7 @@ def run_parallel(
 
 
 @contextmanager
-def _ctrl_c_held():
+def _ctrl_c_held() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) back in this thread until the block ends, where it is raised."""
     block = getattr(signal, "pthread_sigmask", None)
     if block is None or threading.current_thread() is not threading.main_thread():
@@ -122,7 +127,7 @@ def _ctrl_c_held():
         block(signal.SIG_SETMASK, old)
 
 
-def _worker_init(done) -> None:
+def _worker_init(done: ctypes.c_byte) -> None:
     """A worker keeps its map's ``done`` flag (:func:`abandoned`) and ignores Ctrl-C: the
     parent cancels the jobs not yet started and the running ones end. (An idle worker
     interrupted while it waits for a job dies holding the pool's queue, and the pool then
@@ -132,7 +137,7 @@ def _worker_init(done) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _until(pending, get: Callable, stop: Callable | None) -> list:
+def _until(pending: Iterable, get: Callable, stop: Callable | None) -> list:
     """``[get(p) for p in pending]``, ended after the first prefix ``stop`` accepts."""
     out: list = []
     for p in pending:

@@ -13,8 +13,10 @@ RUN_DIR/
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +34,7 @@ RUN_FORMAT = 1
 _VERSIONED = ("config.json", "metrics.json")
 
 
-def _json_default(v):
+def _json_default(v: object) -> object:
     if isinstance(v, np.generic):
         return v.item()
     if isinstance(v, np.ndarray):
@@ -146,7 +148,7 @@ class RunDir:
         """True if the file is there."""
         return self.file(name).is_file()
 
-    def write_json(self, name: str, obj) -> Path:
+    def write_json(self, name: str, obj: Any) -> Path:
         """Write ``obj`` as JSON atomically (``config.json`` and ``metrics.json`` with
         their ``format``, :data:`RUN_FORMAT`)."""
         if name in _VERSIONED and isinstance(obj, dict):
@@ -202,7 +204,13 @@ class RunDir:
         """Read an ``.npz`` written by :meth:`write_arrays`."""
         return readback.read_npz(self.file(name), f"the {name} of an imitwalk run", RunError)
 
-    def start(self, config_json: dict, reference, resume: bool, settings=None):
+    def start(
+        self,
+        config_json: dict,
+        reference: Any,  # a retarget.reference.Reference (runs may not import retarget)
+        resume: bool,
+        settings: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
+    ) -> tuple[dict | None, list[dict]]:
         """Open a learning run: a fresh folder (``config.json`` and ``reference.npz``
         written) or, with ``resume``, the interrupted one, which must have been started
         with the same ``config_json["learn"]`` (compared after ``settings``, a function

@@ -13,6 +13,8 @@ named, so a gain reads as "``gyro_y`` → ``ankle_pitch``", never as an index.
 
 from __future__ import annotations
 
+from collections.abc import Collection, Iterable
+
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
@@ -48,7 +50,7 @@ PHASED = ("turn",)
 FEATURES: tuple[str, ...] = ("gyro_x", "gyro_y", "gyro_z", "roll", "pitch", "heading")
 
 
-def check_names(kind: str, names, valid) -> tuple[str, ...]:
+def check_names(kind: str, names: Iterable[str], valid: Collection[str]) -> tuple[str, ...]:
     """``names`` as a tuple, each one in ``valid`` and none twice.
 
     Raises:

@@ -25,7 +25,9 @@ measured load, at most :data:`~imitwalk.balance.clock.MAX_WAIT_S` per lift-off
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +36,9 @@ from imitwalk.balance.clock import LoadClock
 from imitwalk.balance.estimator import StateEstimator
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
+
+if TYPE_CHECKING:
+    from imitwalk.sim.types import Observation
 
 __all__ = ["Episode", "FeedbackLaw", "TickPolicy"]
 
@@ -59,7 +64,7 @@ class FeedbackLaw:
     box: np.ndarray
     memory: bool = False
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check_names("channel", self.channels, channel_names())
         check_names("feature", self.features, FEATURES)
         m, d = len(self.channels), len(self.features)
@@ -73,7 +78,14 @@ class FeedbackLaw:
             raise ConfigError("feedback gains, nominal and box must be finite (box >= 0)")
 
     @classmethod
-    def zero(cls, channels, features, box, n_ticks: int = 1, memory: bool = False):
+    def zero(
+        cls,
+        channels: Sequence[str],
+        features: Sequence[str],
+        box: float,
+        n_ticks: int = 1,
+        memory: bool = False,
+    ) -> FeedbackLaw:
         """A law that does nothing: zero gains, zero nominal (``box``: one limit for all)."""
         m, d = len(channels), len(features)
         D = 2 * d + m if memory else d
@@ -109,7 +121,7 @@ class FeedbackLaw:
         }
 
     @classmethod
-    def from_arrays(cls, arrays, prefix: str) -> FeedbackLaw:
+    def from_arrays(cls, arrays: Mapping[str, np.ndarray], prefix: str) -> FeedbackLaw:
         """Inverse of :meth:`to_arrays`."""
         ch, feat, mem = (str(x) for x in arrays[f"{prefix}names"])
         return cls(
@@ -176,10 +188,10 @@ class TickPolicy:
         seconds: float,
         explore: float = 0.0,
         hold: int = 8,
-        seed=0,
+        seed: int | tuple[int, ...] = 0,
         offsets: np.ndarray | None = None,
         wait: float = 0.0,
-    ):
+    ) -> None:
         self.laws = tuple(laws)
         self.q_ref = ref.trajectory(scale, seconds)  # (T, n)
         horizon = 2.0 * seconds if wait else seconds  # how far a waiting clock may reach
@@ -212,11 +224,11 @@ class TickPolicy:
         """The loop tick ψ of control tick ``k`` (the start-up shares the loop's timing)."""
         return (k - self.start) % self.n_loop
 
-    def _tick(self, k: int, obs) -> int:
+    def _tick(self, k: int, obs: Observation) -> int:
         """The reference's tick at control tick ``k`` (``k`` itself unless it waits)."""
         return k if self.clock is None else self.clock.tick(k, obs.foot_force)
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         k = min(self._tick(k, obs), len(self.q_cmd) - 1)
         est = self.estimator.update(obs.gyro, obs.accel, obs.foot_force)
         full = np.array([*est.gyro, est.roll, est.pitch, est.heading - self.heading_ref[k]])

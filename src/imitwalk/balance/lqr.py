@@ -45,7 +45,7 @@ class Costs:
     change: float
     horizon: int = 20
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not all(np.isfinite(self.state)) or min(self.state, default=0.0) < 0:
             raise ConfigError(f"costs.state {self.state}: expected finite weights >= 0")
         if not (self.action > 0 and self.change >= 0):

@@ -6,12 +6,14 @@ range here is a search range or a budget; no gain is set by hand.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from imitwalk.balance.channels import CHANNELS, FEATURES, PHASED, check_names
 from imitwalk.config import schedule_scales
 from imitwalk.errors import ConfigError
-from imitwalk.judge.protocol import load_protocol
+from imitwalk.sim.protocol import load_protocol
+from imitwalk.sim.seeds import TRAIN_FIRST, VALIDATION_FIRST
 from imitwalk.sim.types import ENGINES
 
 __all__ = ["STATE_COSTS", "ChoiceConfig", "LqrConfig", "TickLearnConfig", "TrialConfig"]
@@ -29,7 +31,7 @@ STATE_COSTS = {
 }
 
 
-def _range(name: str, values, lo: float, hi: float) -> None:
+def _range(name: str, values: Sequence[float], lo: float, hi: float) -> None:
     if not values:
         raise ConfigError(f"{name}: give at least one value in {lo:g}..{hi:g}")
     for v in values:
@@ -104,7 +106,7 @@ class TrialConfig:
     heading_robots: int = 6
     heading_seconds: float = 30.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         _range("trials.feedforward", self.feedforward, 0.0, 1.0)
         _range("trials.wait", self.wait, 0.0, 0.95)
         _range("trials.pitch", self.pitch, -0.5, 0.5)
@@ -152,7 +154,7 @@ class LqrConfig:
     box: float = 0.15
     trust: tuple[float, ...] = (0.0, 1.0)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check_names("lqr channel", self.channels, [c for c in CHANNELS if c not in PHASED])
         check_names("lqr feature", self.features, FEATURES)
         if self.state_cost and len(self.state_cost) != len(self.features):
@@ -178,24 +180,25 @@ class LqrConfig:
 
 @dataclass(frozen=True)
 class ChoiceConfig:
-    """The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.balance.refchoice`).
+    """The reference choice of ``imitwalk learn CLIP`` (:mod:`imitwalk.learning.refchoice`).
 
     Attributes:
         robots: the training robots each pass's learned controller walks (0: no second
             pass; the open-loop search's reference is learned and kept, as where the
             reference is not searched at all). seconds:
             simulated time each [s]. first: the first robot's seed, a training robot
-            (1001 … 299 999: no evaluation or validation robot).
+            (:data:`~imitwalk.sim.seeds.TRAIN_FIRST` … below
+            :data:`~imitwalk.sim.seeds.VALIDATION_FIRST`: no evaluation or validation robot).
     """
 
     robots: int = 40
     seconds: float = 30.0
-    first: int = 1001
+    first: int = TRAIN_FIRST
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         _range("choice.robots", (self.robots,), 0, 1000)
         _range("choice.seconds", (self.seconds,), 1.0, 600.0)
-        _range("choice.first", (self.first,), 1001, 300_000 - max(self.robots, 1))
+        _range("choice.first", (self.first,), TRAIN_FIRST, VALIDATION_FIRST - max(self.robots, 1))
 
 
 @dataclass(frozen=True)
@@ -229,7 +232,7 @@ class TickLearnConfig:
     workers: int | None = None
     engine: str = "mujoco"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.engine not in ENGINES:
             raise ConfigError(f"engine {self.engine!r}; valid: {', '.join(ENGINES)}")
         if not 0.0 < self.start <= self.stop <= 2.0 or not self.step > 0:

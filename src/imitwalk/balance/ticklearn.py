@@ -36,7 +36,9 @@ Training robots come from ``train_protocol`` with seeds no evaluation uses.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 
 from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.lqr import Costs, horizon_gains
@@ -57,12 +59,12 @@ from imitwalk.config import to_dict
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
-from imitwalk.sim.perturb import TRAIN_SEED_BASE
+from imitwalk.sim.seeds import TRAIN_SEED_BASE
 
 __all__ = ["TickProgress", "learn_tick"]
 
 
-def _learned_law(lr: Learner, episodes: list[Episode]):
+def _learned_law(lr: Learner, episodes: list[Episode]) -> tuple[FeedbackLaw, PhaseModel]:
     """Fit the model on ``episodes`` and turn it into the learned law (and the model);
     the states are the features less their mean at each phase in ``episodes``."""
     c = lr.cfg.lqr
@@ -95,6 +97,7 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
         new = [(scale, r.episode) for r in res if r.episode is not None]
         held = None
         if model is not None:  # the last model, on episodes it has not seen
+            assert learned is not None  # fitted together with the model
             pred = model.score_episodes([e for _, e in new], learned)
             held = pred.to_dict() if pred else None
         data.extend(new)
@@ -164,7 +167,12 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
 
 
 def learn_tick(
-    ref: Reference, robot: Robot, config: TickLearnConfig, run_dir, resume=False, progress=None
+    ref: Reference,
+    robot: Robot,
+    config: TickLearnConfig,
+    run_dir: str | Path,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
 ) -> LearnSummary:
     """Learn to walk ``ref`` on ``robot`` with per-tick feedback; write ``run_dir``.
 

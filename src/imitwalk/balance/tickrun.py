@@ -7,6 +7,7 @@ The learner (:mod:`imitwalk.balance.ticklearn`) runs many of these in parallel
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +16,10 @@ from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
+
+if TYPE_CHECKING:
+    from imitwalk.retarget.reference import Reference
+    from imitwalk.sim.types import Rollout
 
 __all__ = [
     "TickJob",
@@ -84,7 +89,7 @@ class TickResult:
 _REFS: dict = {}
 
 
-def _reference(path: str):
+def _reference(path: str) -> Reference:
     from imitwalk.retarget.reference import Reference
 
     if path not in _REFS:
@@ -93,7 +98,9 @@ def _reference(path: str):
     return _REFS[path]
 
 
-def _walk(job: TickJob, ref=None):
+def _walk(
+    job: TickJob, ref: Reference | None = None
+) -> tuple[Reference, TickPolicy, Rollout, WalkMetrics]:
     """Walk ``job`` on ``ref`` (``None``: the reference at ``job.ref_path``): its reference,
     policy, rollout and metrics."""
     from imitwalk.retarget.feedforward import walk_offsets
@@ -125,7 +132,7 @@ def _walk(job: TickJob, ref=None):
     return ref, policy, ro, m
 
 
-def tick_walk_metrics(job: TickJob, ref) -> WalkMetrics:
+def tick_walk_metrics(job: TickJob, ref: Reference) -> WalkMetrics:
     """The :class:`~imitwalk.sim.metrics.WalkMetrics` of walking ``job`` on ``ref``, a
     :class:`~imitwalk.retarget.reference.Reference` in memory (``job.ref_path`` unused),
     in the calling process."""
@@ -216,7 +223,7 @@ class Trial:
         return summarize(self.results)
 
 
-def best(table: list, yaw_limit_deg: float | None = None):
+def best(table: list, yaw_limit_deg: float | None = None) -> tuple[float, Trial]:
     """The row ``(value, Trial)`` of ``table`` that is kept (:meth:`Trial.rank`)."""
     return min(table, key=lambda row: row[1].rank(row[0], yaw_limit_deg))
 

@@ -4,6 +4,7 @@ episodes, and the controllers a finished run builds (:func:`load_laws`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -110,7 +111,7 @@ def load_learned(rd: RunDir) -> FeedbackLaw | None:
     return FeedbackLaw.from_arrays(rd.read_arrays("learned.npz"), "")
 
 
-def load_laws(run_dir) -> dict[str, tuple[FeedbackLaw, ...]]:
+def load_laws(run_dir: str | Path) -> dict[str, tuple[FeedbackLaw, ...]]:
     """The controllers a finished per-tick run can build, by name: ``feedback`` (the
     trial-picked law), ``learned`` (with the kept fraction of the model-based law on top)
     and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""

@@ -16,9 +16,10 @@ there. G1's trials so walk at 0.3; hoap2's and OP3's are never walked lower.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 
-from imitwalk.balance.feedback import Episode
+from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.balance.tickmodel import nominal_profile
 from imitwalk.balance.tickrun import (
@@ -30,13 +31,13 @@ from imitwalk.balance.tickrun import (
     most_falls,
     run_tick_episode,
 )
-from imitwalk.balance.tickstore import TRIAL_GAINS, feedback_law, stack_episodes
-from imitwalk.judge.protocol import RobotDraw, load_protocol
+from imitwalk.balance.tickstore import TRIAL_GAINS, TrialGain, feedback_law, stack_episodes
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
-from imitwalk.sim.perturb import TRIAL_SEED_BASE
+from imitwalk.sim.protocol import RobotDraw, load_protocol
+from imitwalk.sim.seeds import TRIAL_SEED_BASE
 
 __all__ = [
     "REFERENCE_SETTINGS",
@@ -91,7 +92,14 @@ class TickProgress:
 class Learner:
     """The stages' shared context: the run folder, the robots and the budget."""
 
-    def __init__(self, ref: Reference, robot: Robot, cfg: TickLearnConfig, rd: RunDir, progress):
+    def __init__(
+        self,
+        ref: Reference,
+        robot: Robot,
+        cfg: TickLearnConfig,
+        rd: RunDir,
+        progress: Callable[[str], None] | None,
+    ) -> None:
         self.ref, self.robot, self.cfg, self.rd = ref, robot, cfg, rd
         self.say = progress or (lambda _line: None)
         self.protocol = load_protocol(cfg.train_protocol)
@@ -116,7 +124,9 @@ class Learner:
         self.say(f"trials: every candidate fell on every robot; trials go on at {below[-1]:g}")
         return True
 
-    def robots(self, n: int, first: int, seconds: float, protocol: str | None = None):
+    def robots(
+        self, n: int, first: int, seconds: float, protocol: str | None = None
+    ) -> list[RobotDraw]:
         """``n`` training robots from the ``first``-th on, drawn from ``protocol`` (a
         name; ``None``: the learner's ``train_protocol``)."""
         p = self.protocol if protocol is None else load_protocol(protocol)
@@ -124,17 +134,17 @@ class Learner:
 
     def run(
         self,
-        state,
-        scale,
-        laws,
-        draws,
-        seconds,
-        explore=0.0,
-        rng=0,
-        settings=None,
-        first=0,
-        stop=None,
-    ):
+        state: TickProgress,
+        scale: float,
+        laws: Sequence[FeedbackLaw],
+        draws: Sequence[RobotDraw],
+        seconds: float,
+        explore: float = 0.0,
+        rng: int = 0,
+        settings: dict | None = None,
+        first: int = 0,
+        stop: Callable[[list[TickResult]], bool] | None = None,
+    ) -> list[TickResult]:
         """Walk ``laws`` on ``draws`` (the ``first``-th robot on), the reference played
         with ``settings`` (default: the ones kept); with ``stop``, the shortest prefix of
         the walks it accepts (:func:`~imitwalk.parallel.run_parallel`)."""
@@ -164,7 +174,14 @@ class Learner:
 
 
 def trial(
-    lr: Learner, state, key: str, laws, heading=False, settings=None, most=None, protocol=None
+    lr: Learner,
+    state: TickProgress,
+    key: str,
+    laws: Sequence[FeedbackLaw],
+    heading: bool = False,
+    settings: dict | None = None,
+    most: int | None = None,
+    protocol: str | None = None,
 ) -> Trial:
     """The trials of ``laws`` at the trial scale (the heading's walks if ``heading``), the
     reference played with ``settings`` (default: the ones kept), on training robots from
@@ -208,7 +225,7 @@ def gains_key(gains: dict) -> str:
     return ",".join(f"{g.name}={gains.get(g.name, 0.0):g}" for g in TRIAL_GAINS)
 
 
-def say_table(lr: Learner, head: str, table) -> None:
+def say_table(lr: Learner, head: str, table: list[tuple[float, Trial]]) -> None:
     """One progress line: per candidate, its falls and mean |yaw| ± its standard error."""
     cells = []
     for v, t in table:
@@ -219,7 +236,13 @@ def say_table(lr: Learner, head: str, table) -> None:
     lr.say(f"{head} {' '.join(cells)}")
 
 
-def _table(lr: Learner, state: TickProgress, values, walk, yaw_limit_deg=None) -> list:
+def _table(
+    lr: Learner,
+    state: TickProgress,
+    values: Sequence[float],
+    walk: Callable[[float, int | None], Trial],
+    yaw_limit_deg: float | None = None,
+) -> list:
     """The rows ``(value, Trial)`` of ``values``, each walked by ``walk(value, most)``
     (``most``: :func:`~imitwalk.balance.tickrun.most_falls` against the rows before it) at
     the trial scale, and walked again one scale lower while the table is
@@ -243,7 +266,7 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
     for name in REFERENCE_SETTINGS[len(state.settings) :]:
         candidates = getattr(cfg.trials, name) if lr.ref.plan else (0.0,)
 
-        def walk(value, most, name=name):
+        def walk(value: float, most: int | None, name: str = name) -> Trial:
             settings = {**state.settings, name: value}
             return trial(
                 lr,
@@ -309,7 +332,9 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         limit = cfg.trials.yaw_limit_deg if g.steers else None
         protocol = getattr(cfg.trials, g.protocol) if g.protocol else None
 
-        def walk(value, most, g=g, protocol=protocol):
+        def walk(
+            value: float, most: int | None, g: TrialGain = g, protocol: str | None = protocol
+        ) -> Trial:
             gains = {**state.gains, g.name: value}
             laws = [feedback_law(cfg, gains, state.profiles)]
             return trial(lr, state, gains_key(gains), laws, g.steers, most=most, protocol=protocol)

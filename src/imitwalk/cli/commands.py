@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -11,12 +12,17 @@ from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import recorded_robot, robot_from, standing_robot
 
 if TYPE_CHECKING:
-    from imitwalk.runs import LearnSummary
+    from imitwalk.learning.refchoice import Choice
+    from imitwalk.mocap import Motion
+    from imitwalk.retarget import Reference, RetargetConfig
+    from imitwalk.retarget.search import Walker
+    from imitwalk.robots import Robot
+    from imitwalk.runs import LearnSummary, RunDir
 
 __all__ = ["demo", "learn", "playback", "retarget"]
 
 
-def _motion(args: argparse.Namespace, robot):
+def _motion(args: argparse.Namespace, robot: Robot) -> Motion:
     """The clip: a mocap file, or ``robot``'s motion from another tool (GMR, LocoMuJoCo)."""
     from imitwalk.mocap import default_clip
     from imitwalk.retarget.motionfiles import load_clip
@@ -45,25 +51,13 @@ def retarget(args: argparse.Namespace) -> int:
     motion = _motion(args, robot)
     progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
 
-    _announce_search(cfg)
-    res = run(motion, robot, cfg, progress=search_report, refine_progress=refine_report)
+    res = run(motion, robot, cfg, progress=search_report)
     progress(f"  cycles: {res.template.meta['cycles_report']}")
-    res.reference.settings.update(recorded_robot(args))
-    res.reference.save(args.out)
+    _named(res.reference, args).save(args.out)
     stats = res.stats()
     stats["out"] = str(Path(args.out))
     emit(stats, args.json)
     return 0
-
-
-def _announce_search(cfg) -> None:
-    """What a RetargetConfig's search does after its generations (progress lines)."""
-    sc = cfg.search_config
-    if cfg.searches and sc.refine_rounds:
-        at = "/".join(f"{x:g}" for x in sc.refine_scales)
-        r, n, secs = sc.refine_rounds, sc.refine_models, sc.refine_seconds
-        each = ", each scale on its own" if sc.refine_per_scale else ""
-        progress(f"  then up to {r} refinement rounds: {n} robots x {secs:g} s at {at}{each}")
 
 
 def search_report(gen: int, total: int, score: float, params: dict) -> None:
@@ -72,22 +66,14 @@ def search_report(gen: int, total: int, score: float, params: dict) -> None:
     progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
 
 
-def refine_report(done: int, total: int, trial) -> None:
-    """Progress of the reference refinement (:mod:`imitwalk.retarget.refine`)."""
-    what = (trial.changed or "searched") + ("" if trial.at is None else f" at {trial.at:g}")
-    mark = " (kept)" if trial.changed and trial.kept else ""
-    mark = mark if trial.complete else " (stopped: falls more than the set to beat)"
-    progress(f"  refine {done}/{total}: {what}: {trial.falls}/{trial.robots} fell{mark}")
-
-
 def playback(args: argparse.Namespace) -> int:
     from imitwalk.retarget import Reference
-    from imitwalk.sim.playback import play_reference, summary
+    from imitwalk.retarget.playback import play_reference, summary
 
     ref = Reference.load(args.reference)
     if args.robot is None:
-        args.robot = ref.settings.get("robot", ref.robot)
-        args.joint_map = ref.settings.get("joint_map")
+        args.robot = ref.provenance.robot or ref.robot
+        args.joint_map = ref.provenance.joint_map
     robot = robot_from(args)
     seeds = list(range(args.models))
     progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
@@ -105,19 +91,23 @@ def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
     return rt, [i for i in items if not i.startswith("retarget.")]
 
 
-def _with_command(cfg, args: argparse.Namespace):
-    """``cfg`` (a RetargetConfig) with the ``--turn/--side/--forward/--slope`` flags given."""
-    from dataclasses import replace
+def _named(ref: Reference, args: argparse.Namespace) -> Reference:
+    """``ref`` with the robot as this command named it (for ``evaluate`` to find again)."""
+    where = recorded_robot(args)
+    return replace(ref, provenance=ref.provenance.named(where.robot, where.joint_map))
 
+
+def _with_command(cfg: RetargetConfig, args: argparse.Namespace) -> RetargetConfig:
+    """``cfg`` (a RetargetConfig) with the ``--turn/--side/--forward/--slope`` flags given."""
     flags = {"turn_deg": "turn", "side_m": "side", "forward": "forward", "slope_deg": "slope"}
     given = {k: getattr(args, a) for k, a in flags.items() if getattr(args, a, None) is not None}
     return replace(cfg, command=replace(cfg.command, **given)) if given else cfg
 
 
 def learn(args: argparse.Namespace) -> int:
-    from imitwalk.balance.refchoice import PASSES, learn_clip
     from imitwalk.config import apply_overrides
     from imitwalk.errors import ConfigError
+    from imitwalk.learning.refchoice import PASSES, learn_clip
     from imitwalk.retarget import Reference, RetargetConfig
     from imitwalk.retarget import retarget as do_retarget
     from imitwalk.runs import RunDir
@@ -128,10 +118,10 @@ def learn(args: argparse.Namespace) -> int:
         return _learn_step(args, robot)
     rt_set, learn_set = _split_settings(args.set)
     if args.variant == "faithful":
-        from imitwalk.paper.learnconfig import preset
+        from imitwalk.paper.learnconfig import LearnConfig
         from imitwalk.paper.learner import learn as faithful
 
-        cfg: Any = apply_overrides(preset("faithful", seed=args.seed), learn_set)
+        cfg: Any = apply_overrides(LearnConfig(seed=args.seed), learn_set)
         run: Callable[..., LearnSummary] = faithful
     else:
         from imitwalk.balance.tickconfig import TickLearnConfig
@@ -164,14 +154,12 @@ def learn(args: argparse.Namespace) -> int:
     else:
         motion = _motion(args, robot)
         rcfg = _with_command(rcfg, args)
-        _announce_search(rcfg)
 
-        def make_reference(walker=None):
+        def make_reference(walker: Walker | None = None) -> Reference:
             progress(f"learn: retargeting {motion.source}")
-            res = do_retarget(motion, robot, rcfg, search_report, refine_report, walker=walker)
+            res = do_retarget(motion, robot, rcfg, search_report, walker=walker)
             progress(f"  cycles: {res.template.meta['cycles_report']}")
-            res.reference.settings.update(recorded_robot(args))
-            return res.reference
+            return _named(res.reference, args)
 
         if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
             summary, choice = learn_clip(
@@ -204,12 +192,12 @@ def _variant(args: argparse.Namespace) -> str:
     return "step"
 
 
-def _learn_step(args: argparse.Namespace, robot) -> int:
+def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
     """``learn`` with the stepping gait (the default variant)."""
     from imitwalk.config import apply_overrides
     from imitwalk.errors import ConfigError
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.runs import RunDir
+    from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
     from imitwalk.step.pipeline import learn
 
@@ -244,7 +232,9 @@ def _learn_step(args: argparse.Namespace, robot) -> int:
     return _learned(summary, args, rd)
 
 
-def _learned(summary: LearnSummary, args: argparse.Namespace, rd, choice=None) -> int:
+def _learned(
+    summary: LearnSummary, args: argparse.Namespace, rd: RunDir, choice: Choice | None = None
+) -> int:
     """Print a learning run's summary (and its reference choice, if it made one)."""
     out = {k: v for k, v in summary.to_dict().items() if k not in ("config", "gait")}
     out["variant"] = args.variant

@@ -25,11 +25,12 @@ def run_demo(out: Path) -> dict:
     """Learn the embedded clip, evaluate and report into ``out``; the summary."""
     from imitwalk.config import apply_overrides
     from imitwalk.evidence.report import write_report
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
     from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.retarget.provenance import Provenance
     from imitwalk.robots import load_robot
     from imitwalk.runs import RunDir
+    from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
     from imitwalk.step.pipeline import gait_from_motion, learn_clip
 
@@ -44,7 +45,7 @@ def run_demo(out: Path) -> dict:
         resume = rd.exists("style.json")
         motion = load_motion(default_clip())
         progress(f"[1/4] style: {Path(motion.source).name} on the robot's legs")
-        gait = gait_from_motion(motion, robot, {"robot": "hoap2", "joint_map": None})
+        gait = gait_from_motion(motion, robot, Provenance(robot="hoap2"))
         progress("[2/4] learn: the stepping gait's gains by CMA-ES (demo budget)")
         learn_clip(
             gait,

@@ -42,7 +42,7 @@ def export(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The ``export`` subcommand's arguments."""
     p = sub.add_parser(
         "export",

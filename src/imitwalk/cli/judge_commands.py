@@ -4,19 +4,24 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
+
+if TYPE_CHECKING:
+    from imitwalk.robots import Robot
+    from imitwalk.runs import RunDir
 
 __all__ = ["evaluate", "report"]
 
 
 def evaluate(args: argparse.Namespace) -> int:
     from imitwalk.errors import ConfigError
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
     from imitwalk.robots.urdf import rotor_note
     from imitwalk.runs import RunDir
+    from imitwalk.sim.protocol import load_protocol
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
@@ -64,7 +69,7 @@ def evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _push_recovery(args: argparse.Namespace, rd, robot) -> int:
+def _push_recovery(args: argparse.Namespace, rd: RunDir, robot: Robot) -> int:
     from imitwalk.judge.pushes import push_recovery
 
     progress("evaluate: push recovery, 4 directions x 8 phases, bisection on the nominal robot")

@@ -11,6 +11,7 @@ import argparse
 import sys
 import warnings
 from collections.abc import Sequence
+from typing import TextIO
 
 from imitwalk.cli import (
     commands,
@@ -23,7 +24,7 @@ from imitwalk.cli import (
     sweep_commands,
 )
 from imitwalk.errors import ImitwalkError
-from imitwalk.judge.protocol import PROTOCOLS
+from imitwalk.sim.protocol import PROTOCOLS
 from imitwalk.sim.types import ENGINES
 
 __all__ = ["build_parser", "main"]
@@ -242,7 +243,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+def _one_line_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
     """Print a warning as ``warning: <message>`` (no source line)."""
     print(f"warning: {message}", file=sys.stderr if file is None else file)
 

@@ -45,8 +45,8 @@ def convert(args: argparse.Namespace) -> int:
 
         ref = Reference.load(src)
         if args.robot is None:  # the robot the reference was retargeted to
-            args.robot = ref.settings.get("robot") or ref.robot
-            args.joint_map = args.joint_map or ref.settings.get("joint_map")
+            args.robot = ref.provenance.robot or ref.robot
+            args.joint_map = args.joint_map or ref.provenance.joint_map
         robot = robot_from(args)
         motion = motion_of_reference(ref, robot, args.scale, args.cycles)
     else:
@@ -68,7 +68,7 @@ def convert(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The ``convert`` subcommand's arguments."""
     p = sub.add_parser(
         "convert",

@@ -5,14 +5,21 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
 
+if TYPE_CHECKING:
+    from imitwalk.navigate.trial import NavJob, NavResult
+    from imitwalk.robots import Robot
+    from imitwalk.runs import RunDir
+    from imitwalk.sim.fix import PositionFix
+
 __all__ = ["add_parser", "navigate"]
 
 
-def _robot(args: argparse.Namespace, rd, cfg: dict):
+def _robot(args: argparse.Namespace, rd: RunDir, cfg: dict) -> Robot:
     """The run's robot; ``--robot`` must name the same one."""
     from imitwalk.errors import ConfigError
 
@@ -28,7 +35,7 @@ def _robot(args: argparse.Namespace, rd, cfg: dict):
     return robot
 
 
-def _fix(args: argparse.Namespace):
+def _fix(args: argparse.Namespace) -> PositionFix | None:
     from imitwalk.errors import ConfigError
     from imitwalk.sim.fix import PositionFix
 
@@ -39,12 +46,13 @@ def _fix(args: argparse.Namespace):
     return PositionFix(args.fix_rate, 0.05 if args.fix_noise is None else args.fix_noise)
 
 
-def _video(job, result, path: Path) -> Path:
+def _video(job: NavJob, result: NavResult, path: Path) -> Path:
     """``result``'s recorded walk (of ``job``) rendered to ``path`` (written beside, then
     renamed), the course's waypoints drawn on the floor as discs of its reach."""
     from imitwalk.sim.render import render_frames, write_mp4
     from imitwalk.step.odometry import rot2
 
+    assert result.qpos is not None  # the job was recorded (record=True)
     origin, yaw = result.start  # the start frame, as the judge takes it
     marks = origin + job.course.waypoints @ rot2(yaw).T
     frames = render_frames(
@@ -67,12 +75,12 @@ def navigate(args: argparse.Namespace) -> int:
     from imitwalk.evidence.navplot import course_figure
     from imitwalk.evidence.plots import png_bytes
     from imitwalk.fileio import atomic_write
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.replay import load_run
     from imitwalk.navigate.course import DEFAULT_COURSE, Course, parse_waypoints
     from imitwalk.navigate.trial import NavJob, run_nav_job
     from imitwalk.parallel import run_parallel
     from imitwalk.runs import RunDir
+    from imitwalk.sim.protocol import load_protocol
 
     wp = np.array(DEFAULT_COURSE) if args.waypoints is None else parse_waypoints(args.waypoints)
     course = Course(wp, args.reach)
@@ -151,7 +159,9 @@ def navigate(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub, protocols) -> None:
+def add_parser(
+    sub: argparse._SubParsersAction[argparse.ArgumentParser], protocols: tuple[str, ...]
+) -> None:
     """The ``navigate`` subcommand's arguments."""
     from imitwalk.navigate.course import DEFAULT_COURSE, REACH_M
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +33,7 @@ def emit(obj: dict, as_json: bool, finite: bool = False) -> None:
         print(f"{key:>28}: {val}")
 
 
-def _finite(v):
+def _finite(v: Any) -> Any:
     """``v`` with every non-finite float (also in dicts and lists) replaced by ``None``."""
     if isinstance(v, dict):
         return {k: _finite(x) for k, x in v.items()}
@@ -43,7 +44,7 @@ def _finite(v):
     return v
 
 
-def _plain(v):
+def _plain(v: Any) -> Any:
     if hasattr(v, "item"):
         return v.item()
     if hasattr(v, "tolist"):

@@ -49,7 +49,9 @@ def rl(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub, protocols: tuple[str, ...]) -> None:
+def add_parser(
+    sub: argparse._SubParsersAction[argparse.ArgumentParser], protocols: tuple[str, ...]
+) -> None:
     """The ``rl`` subcommand's arguments."""
     p = sub.add_parser(
         "rl",

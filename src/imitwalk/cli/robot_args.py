@@ -10,11 +10,18 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+from imitwalk.retarget.provenance import Provenance
+
+if TYPE_CHECKING:
+    from imitwalk.robots import Robot
+    from imitwalk.runs import RunDir
 
 __all__ = ["recorded_robot", "robot_from", "robot_label", "run_robot", "standing_robot"]
 
 
-def robot_from(args: argparse.Namespace):
+def robot_from(args: argparse.Namespace) -> Robot:
     """Load the robot named by ``--robot`` / ``--joint-map`` (or the positional ``robot``)."""
     from imitwalk.robots import load_robot
 
@@ -28,7 +35,7 @@ def robot_label(args: argparse.Namespace) -> str:
     return str(args.robot) + (f" (joint map {jm})" if jm else "")
 
 
-def standing_robot(args: argparse.Namespace):
+def standing_robot(args: argparse.Namespace) -> Robot:
     """:func:`robot_from`, refused at once if it cannot stand: the stand check of
     :mod:`imitwalk.sim.standing` (a 2 s hold of the nominal robot, well under a second of
     computing), so that ``learn`` never spends minutes on a robot that falls standing still.
@@ -51,23 +58,23 @@ def _where(robot: str | None) -> str | None:
     return str(Path(robot).resolve())
 
 
-def recorded_robot(args: argparse.Namespace) -> dict[str, str | None]:
+def recorded_robot(args: argparse.Namespace) -> Provenance:
     """Where the command's robot came from, as a run records it (``robot``, ``joint_map``:
     a built-in name, or an absolute path)."""
-    return {"robot": _where(args.robot), "joint_map": _where(getattr(args, "joint_map", None))}
+    return Provenance(robot=_where(args.robot), joint_map=_where(getattr(args, "joint_map", None)))
 
 
-def run_robot(rd, cfg: dict) -> tuple[str, str | None]:
+def run_robot(rd: RunDir, cfg: dict) -> tuple[str, str | None]:
     """The robot a run learned on and its joint map: the file its reference or its
     stepping gait records (a built-in name, or the joint map's path), else the name in
     its ``config.json``."""
     from imitwalk.retarget import Reference
     from imitwalk.step.gait import StepGait
 
-    settings: dict = {}
+    made = Provenance()
     if rd.exists("reference.npz"):
-        settings = Reference.load(rd.file("reference.npz")).settings
+        made = Reference.load(rd.file("reference.npz")).provenance
     elif rd.exists("style.json"):
-        settings = StepGait.load(rd.file("style.json")).settings
-    name = settings.get("robot") or cfg.get("reference", {}).get("robot") or cfg.get("robot")
-    return name or "hoap2", settings.get("joint_map")
+        made = StepGait.load(rd.file("style.json")).provenance
+    name = made.robot or cfg.get("reference", {}).get("robot") or cfg.get("robot")
+    return name or "hoap2", made.joint_map

@@ -71,16 +71,18 @@ def robot_import(args: argparse.Namespace) -> int:
     from imitwalk.errors import RobotError
     from imitwalk.fileio import atomic_write, check_writable
     from imitwalk.robots.draft import draft_joint_map
+    from imitwalk.sim.standing import CHECK_SECONDS, stand_test
 
     out, mjcf = check_writable(args.out, "--out", RobotError), Path(args.mjcf)
     if out.exists() and mjcf.exists() and out.resolve() == mjcf.resolve():
         raise RobotError(f"--out {out} is the MJCF file itself; imitwalk never edits it")
     draft = draft_joint_map(mjcf, out)
-    for line in draft.lines:
+    stand = stand_test(draft.robot, seconds=CHECK_SECONDS)
+    for line in (*draft.lines, stand.line()):
         progress(f"  {line}")
     atomic_write(out, lambda tmp: tmp.write_text(json.dumps(draft.jmap, indent=2) + "\n"))
-    if (advice := draft.advice(str(out))) is not None:
-        progress(f"warning: {advice}; {out} is written for you to edit")
+    if not stand.stands:
+        progress(f"warning: {stand.refusal(str(out))}; {out} is written for you to edit")
     r = draft.robot
     summary = {
         "out": str(out),
@@ -89,8 +91,8 @@ def robot_import(args: argparse.Namespace) -> int:
         "roles": list(r.joint_names),
         "total_mass_kg": r.total_mass,
         "standing_height_m": r.height,
-        "stands": draft.stand.stands,
-        "stand": draft.stand.to_dict(),
+        "stands": stand.stands,
+        "stand": stand.to_dict(),
     }
     emit(summary, args.json, finite=True)
     return 0

@@ -36,7 +36,7 @@ def sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The ``sweep`` subcommand's arguments."""
     p = sub.add_parser(
         "sweep", help="learn and judge clips x robots x settings x seeds on Ray (resumable)"

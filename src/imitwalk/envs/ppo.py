@@ -32,6 +32,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +41,12 @@ from imitwalk.envs.setup import WalkConfig, WalkSetup, build_setup
 from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.runs import LearnSummary, RunDir
+
+if TYPE_CHECKING:
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    from imitwalk.rl.actor import ActorSpec
 
 __all__ = ["LOG_STD_INIT", "PPOConfig", "actor_spec", "train"]
 
@@ -101,7 +108,7 @@ class PPOConfig:
         return d
 
 
-def actor_spec(setup: WalkSetup):
+def actor_spec(setup: WalkSetup) -> ActorSpec:
     """The :class:`~imitwalk.rl.actor.ActorSpec` of an environment's policy."""
     from imitwalk.rl.actor import ActorSpec
 
@@ -112,15 +119,16 @@ def actor_spec(setup: WalkSetup):
     )
 
 
-def _make_env(walk: dict):
-    def make():
+def _make_env(walk: dict) -> Callable[[], gym.Env]:
+    def make() -> gym.Env:
         import gymnasium as gym
         from stable_baselines3.common.monitor import Monitor
 
         from imitwalk.envs.walk import WalkEnv
 
         env = WalkEnv(**walk)
-        return Monitor(gym.wrappers.RescaleAction(env, -1.0, 1.0))
+        # gymnasium's stub wants NumPy numbers for the bounds; Python floats work alike
+        return Monitor(gym.wrappers.RescaleAction(env, -1.0, 1.0))  # type: ignore[arg-type]
 
     return make
 
@@ -151,7 +159,7 @@ def _start(rd: RunDir, walk: WalkConfig, cfg: PPOConfig, resume: bool) -> WalkSe
 def train(
     walk: WalkConfig,
     cfg: PPOConfig,
-    out,
+    out: str | Path,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> LearnSummary:
@@ -220,14 +228,15 @@ def train(
 
     state = {"snapshots": int(model.num_timesteps) // every, "saved": int(model.num_timesteps)}
 
-    def checkpoint(m) -> None:
+    def checkpoint(m: PPO) -> None:
         """Save the model, its policy and a log line: after each update, so that the
         model, the policy and the step count always agree."""
         steps = int(m.num_timesteps)
         if steps == state["saved"]:
             return
         state["saved"] = steps
-        eps = list(m.ep_info_buffer)
+        # SB3 declares the buffer optional; learn() has made it by the first callback
+        eps = list(m.ep_info_buffer)  # type: ignore[arg-type]
         line = {
             "timesteps": steps,
             "sim_seconds": steps * dt,
@@ -256,7 +265,7 @@ def train(
             return True
 
         def _on_rollout_start(self) -> None:  # the last rollout's update is done
-            checkpoint(self.model)
+            checkpoint(self.model)  # type: ignore[arg-type]  # SB3 says BaseAlgorithm: this PPO
 
     try:
         remaining = max(total - int(model.num_timesteps), 0)
@@ -281,6 +290,6 @@ def train(
     return summary
 
 
-def _save_model(model, tmp: Path) -> None:
+def _save_model(model: PPO, tmp: Path) -> None:
     with open(tmp, "wb") as fh:  # a file object: SB3 adds no ".zip" to its name
         model.save(fh)

@@ -17,12 +17,12 @@ import numpy as np
 from imitwalk.envs.rewards import RewardWeights
 from imitwalk.envs.tracking import TrackingTarget
 from imitwalk.errors import ConfigError, unknown_name
-from imitwalk.judge.protocol import Protocol, load_protocol
 from imitwalk.rl.observation import ACTIONS, ObservationLayout
 from imitwalk.robots import Robot
+from imitwalk.sim.protocol import Protocol, load_protocol
+from imitwalk.sim.seeds import TRAIN_FIRST
 from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
-from imitwalk.step.learn import TRAIN_FIRST
 from imitwalk.step.style import GaitStyle
 
 if TYPE_CHECKING:
@@ -146,6 +146,7 @@ def _base(cfg: WalkConfig, robot: Robot) -> tuple[Motion, StepGait, StepGains]:
     gains: a stepping run's, or the clip's with the shipped gains."""
     from imitwalk.mocap import default_clip
     from imitwalk.retarget.motionfiles import load_clip
+    from imitwalk.retarget.provenance import Provenance
     from imitwalk.step.pipeline import gait_from_motion
 
     if cfg.run is not None:
@@ -165,7 +166,7 @@ def _base(cfg: WalkConfig, robot: Robot) -> tuple[Motion, StepGait, StepGains]:
         gait = loaded.step_gait
         return load_clip(gait.source, robot), gait, loaded.step_gains["learned"]
     motion = load_clip(cfg.clip or default_clip(), robot)
-    where = {"robot": cfg.robot, "joint_map": None}  # as a run records its robot
+    where = Provenance(robot=cfg.robot)  # as a run records its robot
     return motion, gait_from_motion(motion, robot, where), StepGains()
 
 

@@ -1,6 +1,6 @@
 """``imitwalk/Walk-v0``: a Gymnasium environment of a humanoid walking a clip.
 
-One episode is one robot drawn from a protocol (:mod:`imitwalk.judge.protocol`: its
+One episode is one robot drawn from a protocol (:mod:`imitwalk.sim.protocol`: its
 friction, masses, servos, slope, noise and kicks), walking for ``seconds``:
 
 - **observation** (:mod:`imitwalk.rl.observation`): only what the robot measures,
@@ -21,7 +21,7 @@ the physics.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
@@ -32,6 +32,10 @@ from imitwalk.envs.tracking import sole_offsets
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.sim.mujoco import MujocoPlant
 from imitwalk.sim.truth import body_truth
+
+if TYPE_CHECKING:
+    from imitwalk.sim.render import Renderer
+    from imitwalk.sim.types import Observation
 
 __all__ = ["RENDER_MODES", "WalkEnv"]
 
@@ -54,7 +58,9 @@ class WalkEnv(gym.Env):
         "render_fps": 30,
     }
 
-    def __init__(self, render_mode: str | None = None, setup: WalkSetup | None = None, **config):
+    def __init__(
+        self, render_mode: str | None = None, setup: WalkSetup | None = None, **config: Any
+    ):
         if render_mode is not None and render_mode not in RENDER_MODES:
             raise unknown_name("render mode", str(render_mode), RENDER_MODES, ConfigError)
         self.setup = setup if setup is not None else build_setup(WalkConfig(**config))
@@ -66,11 +72,13 @@ class WalkEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -np.inf, np.inf, shape=(s.layout.size,), dtype=np.float32
         )
-        self._renderer = None
+        self._renderer: Renderer | None = None
         self.plant: MujocoPlant | None = None
 
     # -- the episode ------------------------------------------------------------
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         s, cfg = self.setup, self.setup.config
         options = options or {}
@@ -99,7 +107,7 @@ class WalkEnv(gym.Env):
         self.base_prev = self.base
         return self._observe(obs), {"robot_seed": robot_seed}
 
-    def step(self, action):
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self.plant is None:
             raise gym.error.ResetNeeded("call reset() before step()")
         s, cfg = self.setup, self.setup.config
@@ -144,7 +152,7 @@ class WalkEnv(gym.Env):
         }
         return self._observe(obs), reward, terminated, truncated, info
 
-    def _observe(self, obs) -> np.ndarray:
+    def _observe(self, obs: Observation) -> np.ndarray:
         s = self.setup
         if self.controller is not None:
             phase = self.controller.phase
@@ -153,7 +161,7 @@ class WalkEnv(gym.Env):
         return s.layout.encode(obs, phase, self.previous, self.base)
 
     # -- pictures ---------------------------------------------------------------
-    def render(self):
+    def render(self) -> np.ndarray | None:
         if self.render_mode is None or self.plant is None:
             return None
         if self._renderer is None:

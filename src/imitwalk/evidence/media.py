@@ -9,8 +9,10 @@ Rendering goes through :mod:`imitwalk.sim.render` (offscreen, fast settings).
 from __future__ import annotations
 
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +23,14 @@ from imitwalk.judge.replay import LoadedRun
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary
 from imitwalk.sim.mujoco import MujocoPlant, Rollout, SimOptions, make_plant, run
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from imitwalk.paper.gait import GaitModel
+    from imitwalk.retarget.reference import Reference
+    from imitwalk.sim.render import Renderer
+    from imitwalk.step.gait import StepGait
 
 __all__ = [
     "Replays",
@@ -101,7 +111,9 @@ def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> 
     return np.asarray(img)
 
 
-def video(robot: Robot, runs: list[tuple[str, Rollout]], seconds: float, s: ReportSettings):
+def video(
+    robot: Robot, runs: list[tuple[str, Rollout]], seconds: float, s: ReportSettings
+) -> list[np.ndarray]:
     """Side-by-side frames ``(H, 2W + 4, 3)`` of the two runs, labelled."""
     from imitwalk.sim.render import render_frames
 
@@ -127,7 +139,9 @@ def video(robot: Robot, runs: list[tuple[str, Rollout]], seconds: float, s: Repo
     return [np.hstack([a, gap, b]) for a, b in zip(*halves, strict=True)]
 
 
-def robot_strip(renderer, ro: Rollout, period: float, count: int) -> tuple[list, list[str]]:
+def robot_strip(
+    renderer: Renderer, ro: Rollout, period: float, count: int
+) -> tuple[list[np.ndarray], list[str]]:
     """Images of the last gait cycle of a run (the fallen robot, if it fell)."""
     t_end = ro.seconds
     times = np.linspace(max(0.0, t_end - period), t_end, count, endpoint=False)
@@ -135,7 +149,7 @@ def robot_strip(renderer, ro: Rollout, period: float, count: int) -> tuple[list,
     return [renderer.frame(ro.qpos[i]) for i in idx], [f"t = {ro.t[i]:.2f} s" for i in idx]
 
 
-def human_strip(ref, count: int):
+def human_strip(ref: Reference | StepGait, count: int) -> tuple[Figure | None, str | None]:
     """Fig. 8's first row (or the reason it is missing)."""
     from imitwalk.errors import MocapError
     from imitwalk.mocap import load_motion
@@ -176,7 +190,7 @@ class Replays:
     after: Rollout
     actions: np.ndarray
 
-    def postures(self, gait) -> np.ndarray:
+    def postures(self, gait: GaitModel) -> np.ndarray:
         """``(T, k)`` the learned run's commanded joint targets in the subspace, over its
         last two gait cycles (up to its fall)."""
         q = self.after.q_cmd
@@ -185,7 +199,7 @@ class Replays:
             q = q[: max(1, round(self.after.fall_time / self.after.control_dt))]
         return gait.subspace.transform(q[-2 * gait.n_ticks :])
 
-    def paths(self, ref):
+    def paths(self, ref: Reference | StepGait) -> Figure:
         """Top view of the two runs' torso paths and the path ``ref`` commands."""
         commanded = ref.ground_path(self.scale, self.after.seconds)
         return curves.torso_paths([(n, ro.torso_pos) for n, ro in self.runs], commanded)
@@ -196,7 +210,13 @@ class Replays:
         return [("before: open loop", self.before), ("after: learned", self.after)]
 
 
-def replay(run_: LoadedRun, robot: Robot, seconds: float, scale: float | None = None, options=None):
+def replay(
+    run_: LoadedRun,
+    robot: Robot,
+    seconds: float,
+    scale: float | None = None,
+    options: SimOptions | None = None,
+) -> Replays:
     """Run the open-loop reference and the learned controller of a loaded run
     (:func:`~imitwalk.judge.replay.load_run`) for ``seconds`` [s] at ``scale`` (default: the
     scale reached) on the engine it learned on, without stopping at a fall; ``options``:
@@ -218,7 +238,9 @@ def replay(run_: LoadedRun, robot: Robot, seconds: float, scale: float | None = 
     return Replays(scale, before, after, actions)
 
 
-def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int, controller: str = "learned"):
+def kick_strip(
+    renderer: Renderer, run_: LoadedRun, robot: Robot, count: int, controller: str = "learned"
+) -> tuple[Figure, str]:
     """One kick, rendered: ``controller`` on the nominal robot kicked to the left
     at the left heel strike two cycles after the start-up, by half the hard protocol's
     largest kick; ``count`` images over the 1.5 s after it. Returns (figure, caption)."""
@@ -241,7 +263,7 @@ def kick_strip(renderer, run_: LoadedRun, robot: Robot, count: int, controller: 
     return fig, f"A kick of {speed:.2f} m/s to the left; the robot {outcome(ro)}."
 
 
-def save_strip(figs, path: Path) -> Path:
+def save_strip(figs: Sequence[Figure], path: Path) -> Path:
     """The film-strip figures stacked into one PNG (white-padded to the widest)."""
     from PIL import Image
 

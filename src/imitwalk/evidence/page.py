@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import base64
 import html
+from typing import TYPE_CHECKING
 
 from imitwalk.evidence import curves, plots
 from imitwalk.judge import tables
 from imitwalk.judge.records import ProtocolVerdict, PushVerdict
 from imitwalk.runs import RunDir
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["STYLE", "b64", "evaluations", "figure", "img", "robustness", "section"]
 
@@ -18,7 +22,7 @@ def b64(data: bytes) -> str:
     return base64.b64encode(data).decode("ascii")
 
 
-def img(fig, alt: str) -> str:
+def img(fig: Figure, alt: str) -> str:
     png = plots.png_bytes(fig)
     return f'<img src="data:image/png;base64,{b64(png)}" alt="{html.escape(alt)}">'
 

@@ -10,11 +10,19 @@ from __future__ import annotations
 
 import io
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from mpl_toolkits.mplot3d.axes3d import Axes3D
+
+    from imitwalk.mocap.motion import Motion
+    from imitwalk.paper.gait import GaitModel
 
 __all__ = [
     "example_ticks",
@@ -69,7 +77,7 @@ def example_ticks(n_ticks: int, count: int = 6) -> np.ndarray:
     return np.linspace(0, n_ticks, count, endpoint=False).astype(int)
 
 
-def _pcs(gait, scale: float) -> np.ndarray:
+def _pcs(gait: GaitModel, scale: float) -> np.ndarray:
     """``(N, 3)`` the reference loop at ``scale`` on the first three PCs."""
     return gait.subspace.transform(gait.ref.at_scale(scale)[1])[:, :3]
 
@@ -79,7 +87,7 @@ def _closed(X: np.ndarray) -> np.ndarray:
     return np.vstack([X, X[:1]])
 
 
-def _split(title: str):
+def _split(title: str) -> tuple[Figure, Axes3D, list[Axes]]:
     """A figure with a 3-D axes on the left and r, h against φ on the right."""
     fig = _figure(10.0, 4.6)
     gs = fig.add_gridspec(2, 2, width_ratios=[1.4, 1.0])
@@ -93,17 +101,17 @@ def _split(title: str):
     return fig, ax, rh
 
 
-def _pc_labels(ax, gait) -> None:
+def _pc_labels(ax: Axes3D, gait: GaitModel) -> None:
     evr = getattr(gait.subspace, "explained_variance_ratio_", np.full(3, np.nan))
     for i, set_label in enumerate((ax.set_xlabel, ax.set_ylabel, ax.set_zlabel)):
         set_label(f"PC{i + 1} ({100 * evr[i]:.0f} %)")
 
 
 def fig3_subspace(
-    gait,
+    gait: GaitModel,
     scale: float,
     pose_images: Sequence[np.ndarray] | None = None,
-    ticks: Sequence[int] | None = None,
+    ticks: Sequence[int] | np.ndarray | None = None,
 ) -> Figure:
     """Fig. 3: the gait loop in (PC1, PC2, PC3), blue diamonds along the fitted loop and
     red circles, numbered, at example poses (``ticks``, default :func:`example_ticks`);
@@ -135,7 +143,7 @@ def fig3_subspace(
     return fig
 
 
-def fig4_embedding(gait, scale: float) -> Figure:
+def fig4_embedding(gait: GaitModel, scale: float) -> Figure:
     """Fig. 4: training points (blue dots) and the fitted action space g(φ) (red curve) in
     the (x_θ, y_θ, z_θ) frame of eq. 1 centred on μ; beside, r and h against φ (eq. 2)."""
     emb = gait.embedding(scale)
@@ -163,7 +171,7 @@ def fig4_embedding(gait, scale: float) -> Figure:
 
 
 def fig6_optimized(
-    gait, scale: float, actions: np.ndarray, postures: np.ndarray | None = None
+    gait: GaitModel, scale: float, actions: np.ndarray, postures: np.ndarray | None = None
 ) -> Figure:
     """Fig. 6: executed actions ``(T, 3)`` (φ, r, h), mapped by g into the subspace, against
     the reference loop; beside, r and h of the actions against φ with g(φ). ``postures``
@@ -194,7 +202,7 @@ def fig6_optimized(
 
 
 def fig7_schedule(
-    gait,
+    gait: GaitModel,
     scales_passed: Sequence[float],
     actions: np.ndarray | None = None,
     reached: float | None = None,
@@ -254,7 +262,7 @@ def film_strip(images: Sequence[np.ndarray], titles: Sequence[str], label: str =
     return fig
 
 
-def skeleton_strip(motion, frames: Sequence[int], label: str = "") -> Figure:
+def skeleton_strip(motion: Motion, frames: Sequence[int], label: str = "") -> Figure:
     """The human stick figure from ``motion.keypoints`` at ``frames``, seen from the side
     (horizontal axis: the walking direction [m], each panel centred on the pelvis; left
     limbs blue, right red)."""

@@ -15,7 +15,9 @@ from __future__ import annotations
 import html
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from imitwalk.config import schedule_scales
 from imitwalk.evidence import curves, media, plots
@@ -26,10 +28,17 @@ from imitwalk.paper.gait import GaitConfig, GaitModel
 from imitwalk.robots import Robot, load_robot
 from imitwalk.runs import RunDir
 
+if TYPE_CHECKING:
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from imitwalk.retarget.reference import Reference
+    from imitwalk.step.gait import StepGait
+
 __all__ = ["write_report"]
 
 
-def _fmt(v) -> str:
+def _fmt(v: object) -> str:
     if isinstance(v, dict) and "mean" in v:
         if v["mean"] is None:  # a figure no seed recorded
             return "–"
@@ -42,10 +51,10 @@ def _fmt(v) -> str:
 
 
 def write_report(
-    run_dir,
+    run_dir: str | Path,
     robot: Robot | None = None,
     seconds: float = 10.0,
-    progress=None,
+    progress: Callable[[str], None] | None = None,
     settings: media.ReportSettings | None = None,
 ) -> Path:
     """Write ``RUN_DIR/report.html`` (and ``before_after.mp4``, ``filmstrip.png``).
@@ -67,8 +76,9 @@ def write_report(
     rd = RunDir(run_dir)
     lg = load_run(run_dir)
     config = rd.read_json("config.json")
-    where = lg.ref.settings.get("robot") or config.get("robot", lg.ref.robot)  # a file, or a name
-    robot = robot or load_robot(where, lg.ref.settings.get("joint_map"))
+    made = lg.ref.provenance
+    where = made.robot or config.get("robot", lg.ref.robot)  # a file, or a name
+    robot = robot or load_robot(where, made.joint_map)
     if lg.learner in ("step", "rl"):
         from imitwalk.evidence.step_report import write_step_report
 
@@ -119,7 +129,13 @@ def write_report(
     return out
 
 
-def _fig8(ref, rp: media.Replays, strips, count: int, png: Path) -> str:
+def _fig8(
+    ref: Reference | StepGait,
+    rp: media.Replays,
+    strips: list[tuple[list[np.ndarray], list[str]]],
+    count: int,
+    png: Path,
+) -> str:
     """Fig. 8's rows as HTML; also saved, stacked, as ``png``."""
     human, missing = media.human_strip(ref, count)
     rows = [] if human is None else [(human, "film strip: human")]
@@ -153,7 +169,16 @@ def _display_gait(lg: LoadedRun) -> GaitModel:
 
 
 def _sections(
-    rd: RunDir, lg: LoadedRun, gait, rp: media.Replays, config, video, fig8, poses, ticks, kick
+    rd: RunDir,
+    lg: LoadedRun,
+    gait: GaitModel,
+    rp: media.Replays,
+    config: dict,
+    video: str,
+    fig8: str,
+    poses: list[np.ndarray],
+    ticks: np.ndarray,
+    kick: tuple[Figure, str],
 ) -> str:
     scale, log, m = rp.scale, rd.read_log(), lg.metrics
     passed = [float(p) for p in m.scales_passed]
@@ -205,7 +230,7 @@ def _sections(
             figure(
                 img(rp.paths(lg.ref), "torso paths"),
                 f"The replays above from above; dashed: the path the reference commands "
-                f"({lg.reference.gait_command().describe()}).",
+                f"({lg.reference.command.describe()}).",
             ),
         ),
         (

@@ -16,7 +16,9 @@ from __future__ import annotations
 import html
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from imitwalk.evidence import curves, media, plots
 from imitwalk.evidence.page import STYLE, b64, evaluations, figure, img, robustness, section
@@ -26,6 +28,9 @@ from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim.metrics import gait_timing
 from imitwalk.sim.mujoco import Rollout, make_plant, run
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["imitation_rows", "write_step_report"]
 
@@ -91,7 +96,7 @@ def imitation_rows(lg: LoadedRun, ro: Rollout, robot: Robot) -> list[tuple[str, 
     ]
 
 
-def _imitation(lg: LoadedRun, robot: Robot, runs, strip: str) -> str:
+def _imitation(lg: LoadedRun, robot: Robot, runs: list[tuple[str, Rollout]], strip: str) -> str:
     rows = imitation_rows(lg, runs[-1][1], robot)
     head = "<tr><th></th><th>human</th><th>style on the robot</th><th>robot, measured</th></tr>"
     body = "".join(
@@ -146,7 +151,13 @@ def _learning(rd: RunDir, lg: LoadedRun) -> str:
     return figure(img(fig, "learning curve"), caption)
 
 
-def _strips(lg: LoadedRun, robot: Robot, runs, rd: RunDir, s: media.ReportSettings):
+def _strips(
+    lg: LoadedRun,
+    robot: Robot,
+    runs: list[tuple[str, Rollout]],
+    rd: RunDir,
+    s: media.ReportSettings,
+) -> tuple[str, tuple[Figure, str]]:
     """Fig. 8's rows (the human, the robot) as HTML, and one kick's strip and caption."""
     from imitwalk.sim.render import Renderer
 
@@ -169,11 +180,11 @@ def _strips(lg: LoadedRun, robot: Robot, runs, rd: RunDir, s: media.ReportSettin
 
 
 def write_step_report(
-    run_dir,
+    run_dir: str | Path,
     lg: LoadedRun,
     robot: Robot,
     seconds: float = 10.0,
-    progress=None,
+    progress: Callable[[str], None] | None = None,
     settings: media.ReportSettings | None = None,
 ) -> Path:
     """Write ``RUN_DIR/report.html`` of a stepping run (see the module doc); the walks

@@ -1,2 +1,3 @@
-"""Judging a learned run: evaluation protocols (JSON in :mod:`imitwalk.judge.protocols`),
-the verdict on a protocol's robots, push recovery, loading runs back, and result tables."""
+"""Judging a learned run: the verdict on a protocol's robots (the robots themselves are
+drawn by :mod:`imitwalk.sim.protocol`), push recovery, loading runs back, and result
+tables."""

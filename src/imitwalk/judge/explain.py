@@ -1,13 +1,13 @@
 """Why a robot fell: each of its drawn factors set back to nominal, one at a time.
 
 A protocol's robot draws every factor at once, and the factor drawn furthest from
-nominal (:attr:`~imitwalk.judge.protocol.RobotDraw.furthest`) need not be the one that
+nominal (:attr:`~imitwalk.sim.protocol.RobotDraw.furthest`) need not be the one that
 fells it. Eval's seed 14, for example, drew its initial twist furthest from nominal, yet
 under the default clip's learned controller it still falls with the twist taken away,
 and walks with its servo stiffnesses alone set back to nominal. :func:`explain_falls`
 walks every fallen robot again once per factor of the protocol, with that factor at
 nominal and every other one exactly as drawn
-(:meth:`~imitwalk.judge.protocol.Protocol.only` keeps each factor's own draws), and
+(:meth:`~imitwalk.sim.protocol.Protocol.only` keeps each factor's own draws), and
 names the factors whose removal alone lets the robot walk the whole time. A fall that no
 single removal saves comes from several factors together, or, on the nominal robot, from
 none.
@@ -20,9 +20,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
-from imitwalk.judge.protocol import Protocol
 from imitwalk.parallel import run_parallel
+from imitwalk.sim.protocol import Protocol
+
+if TYPE_CHECKING:
+    from imitwalk.robots import Robot
 
 __all__ = ["explain_falls"]
 
@@ -32,7 +36,7 @@ def explain_falls(
     jobs: list,
     walks: list,
     protocol: Protocol,
-    robot,
+    robot: Robot,
     seconds: float,
     workers: int | None = None,
 ) -> dict[tuple[str, int], tuple[str, ...]]:

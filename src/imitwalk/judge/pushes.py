@@ -4,7 +4,7 @@ On the nominal robot at the scale the run reached, the walk is kicked once, two 
 cycles after the start-up, at one of :data:`PHASES` phases of the cycle and in one of
 four horizontal directions (:data:`DIRECTIONS`, in the walking frame: forward, back,
 left, right). A kick is a velocity change of the whole robot (as the protocols' pushes,
-:mod:`imitwalk.judge.protocol`). For every (controller, direction, phase) the largest kick the
+:mod:`imitwalk.sim.protocol`). For every (controller, direction, phase) the largest kick the
 robot survives for :data:`AFTER_S` seconds is found by bisection between 0 and
 :func:`top_speed` (the protocols' largest kick for this robot's height, twice over).
 """
@@ -12,15 +12,22 @@ robot survives for :data:`AFTER_S` seconds is found by bisection between 0 and
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.judge.records import PushSettings, PushSide, PushVerdict
-from imitwalk.judge.replay import load_run
+from imitwalk.judge.replay import LoadedRun, load_run
 from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.sim.types import SimOptions
+
+if TYPE_CHECKING:
+    from imitwalk.retarget.reference import Reference
+    from imitwalk.step.gait import StepGait
 
 __all__ = ["AFTER_S", "DIRECTIONS", "PHASES", "PushJob", "push_recovery", "top_speed"]
 
@@ -58,14 +65,14 @@ class PushJob:
 _CACHE: dict = {}
 
 
-def _run(path: str):
+def _run(path: str) -> LoadedRun:
     if path not in _CACHE:
         _CACHE.clear()
         _CACHE[path] = load_run(path)
     return _CACHE[path]
 
 
-def kick_time(ref, phase: int) -> float:
+def kick_time(ref: Reference | StepGait, phase: int) -> float:
     """When [s] the kick at ``phase`` comes: two cycles after the start-up, plus the phase
     (a stepping gait says when its own walk is steady:
     :meth:`~imitwalk.step.gait.StepGait.kick_time`)."""
@@ -94,7 +101,11 @@ def survives(job: PushJob) -> bool:
 
 
 def push_recovery(
-    run_dir, robot: Robot, controllers=None, scale: float | None = None, workers=None
+    run_dir: str | Path,
+    robot: Robot,
+    controllers: Iterable[str] | None = None,
+    scale: float | None = None,
+    workers: int | None = None,
 ) -> PushVerdict:
     """The largest kick survived per controller, direction and phase (a table [m/s]).
 

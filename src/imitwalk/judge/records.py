@@ -11,9 +11,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from imitwalk.errors import RunError
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 __all__ = [
     "ControllerVerdict",
@@ -117,7 +120,7 @@ class ControllerVerdict:
         return cls(**{**own, "survival_ci95": (float(lo), float(hi)), "per_seed": rows})
 
 
-def _own(cls, d: dict) -> dict[str, Any]:
+def _own(cls: type[DataclassInstance], d: dict) -> dict[str, Any]:
     """``cls``'s fields as ``d`` holds them; a field later releases added with a default
     of ``None`` is ``None`` where ``d``, written before, lacks it."""
     return {

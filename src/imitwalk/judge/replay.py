@@ -17,7 +17,8 @@ trained beside, a residual policy's base); the others build theirs and ``open_lo
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -27,7 +28,9 @@ from imitwalk.runs import LearnSummary, RunDir
 
 if TYPE_CHECKING:
     from imitwalk.paper.evaluate import LearnedGait
+    from imitwalk.robots import Robot
     from imitwalk.runtime.bundle import Bundle
+    from imitwalk.sim.types import Observation
     from imitwalk.step.gait import StepGait
 
 __all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
@@ -39,11 +42,11 @@ OPEN_LOOP = "open_loop"
 class _OpenLoop:
     """The reference's trajectory as a policy, starting where it starts."""
 
-    def __init__(self, ref: Reference, scale: float, seconds: float):
+    def __init__(self, ref: Reference, scale: float, seconds: float) -> None:
         self.q = ref.trajectory(scale, seconds)
         self.q0 = self.q[0]
 
-    def __call__(self, k: int, _obs):
+    def __call__(self, k: int, _obs: Observation) -> np.ndarray:
         return self.q[min(k, len(self.q) - 1)]
 
 
@@ -133,7 +136,7 @@ class LoadedRun:
                 return other
         return controller
 
-    def bundle(self, controller: str, robot, scale: float | None = None) -> Bundle:
+    def bundle(self, controller: str, robot: Robot, scale: float | None = None) -> Bundle:
         """A stepping or PPO run's controller ``controller`` at ``scale`` (default: the
         scale reached) as :mod:`imitwalk.runtime` plays it, and ``imitwalk export``
         writes it.
@@ -166,7 +169,11 @@ class LoadedRun:
         style, gains = self.step_gait.at_scale(scale), self.step_gains[controller]
         return Bundle("stepping", robot, self.ref.dt, style, gains, source=source)
 
-    def policy(self, controller: str, robot, scale: float | None = None, seconds: float = 30.0):
+    # Any: a policy ``(tick, observation) -> targets`` of one of several classes, whose
+    # extras callers read where present (a faithful run's ``tick_actions``, ``first_loop_tick``)
+    def policy(
+        self, controller: str, robot: Robot, scale: float | None = None, seconds: float = 30.0
+    ) -> Any:
         """A fresh controller ``controller`` (no exploration) at ``scale`` (default: the
         scale reached) for a walk of ``seconds`` [s].
 
@@ -195,7 +202,7 @@ class LoadedRun:
         return self.gait.policy(scale)
 
 
-def load_run(run_dir) -> LoadedRun:
+def load_run(run_dir: str | Path) -> LoadedRun:
     """Read a finished run folder (a one-line :class:`~imitwalk.errors.RunError` if it is
     not one)."""
     rd = RunDir(run_dir)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import html
 
-from imitwalk.judge.records import ProtocolVerdict, PushVerdict
+from imitwalk.judge.records import ControllerVerdict, ProtocolVerdict, PushVerdict
 
 __all__ = ["protocol_table", "push_table"]
 
@@ -51,7 +51,7 @@ def protocol_table(result: ProtocolVerdict) -> str:
     return caption + "<table>" + head + "".join(rows) + "</table>" + _explained(sides)
 
 
-def _explained(sides) -> str:
+def _explained(sides: dict[str, ControllerVerdict]) -> str:
     """The falls explained (``evaluate --explain-falls``), one line per controller."""
     lines = [
         f"<li>{html.escape(name)}: {html.escape(line)}</li>"

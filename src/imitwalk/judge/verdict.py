@@ -1,6 +1,6 @@
 """Judging a run on a robustness protocol: every controller on the same robots.
 
-:func:`judge_protocol` draws ``seeds`` robots from a :class:`~imitwalk.judge.protocol.Protocol`
+:func:`judge_protocol` draws ``seeds`` robots from a :class:`~imitwalk.sim.protocol.Protocol`
 and walks each controller the run can build on every one of them, for ``seconds``
 from standing. Per controller it reports survival with its 95 % Wilson interval,
 distance, speed and mean |yaw| drift, and the falls broken down by the factor each
@@ -12,13 +12,14 @@ the controller, so the comparison is paired.
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.judge.explain import explain_falls
-from imitwalk.judge.protocol import Protocol
 from imitwalk.judge.records import (
     ControllerVerdict,
     JudgeSettings,
@@ -32,6 +33,7 @@ from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim.metrics import WalkMetrics, walk_metrics
+from imitwalk.sim.protocol import Protocol
 from imitwalk.sim.types import SimOptions
 
 __all__ = ["JudgeJob", "RobotWalk", "judge_protocol", "run_controller"]
@@ -117,7 +119,7 @@ def run_controller(job: JudgeJob) -> RobotWalk:
 
 
 def _side(
-    runs: list[RobotWalk], factors, saved: dict[int, tuple] | None = None
+    runs: list[RobotWalk], factors: Collection[str], saved: dict[int, tuple] | None = None
 ) -> ControllerVerdict:
     """One controller's verdict (``saved``: seed → the factors saving its fall, if
     the falls were explained)."""
@@ -129,7 +131,7 @@ def _side(
         if r.metrics.fell and r.furthest is not None:
             by[r.furthest] = by.get(r.furthest, 0) + 1
 
-    def mean(xs) -> float | None:
+    def mean(xs: list[float]) -> float | None:
         return float(np.mean(xs)) if runs else None
 
     lo, hi = wilson(n - falls, n)
@@ -153,7 +155,7 @@ def _side(
 
 
 def judge_protocol(
-    run_dir,
+    run_dir: str | Path,
     robot: Robot,
     protocol: Protocol,
     seeds: int = 40,

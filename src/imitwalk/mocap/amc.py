@@ -121,7 +121,9 @@ def _parse_amc(lines: list[str], skel: Skeleton, src: str) -> _AmcValues:
     return _AmcValues(n, arrays, {k: np.array(v) for k, v in at.items()}, angle_scale)
 
 
-def _forward_kinematics(skel: Skeleton, values: dict[str, np.ndarray], n: int, amc_scale: float):
+def _forward_kinematics(
+    skel: Skeleton, values: dict[str, np.ndarray], n: int, amc_scale: float
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Start and end ``(T, 3)`` of each bone in ASF axes [m] (``amc_scale``: AMC angle
     unit -> degrees)."""
     scale = skel.metres_per_unit

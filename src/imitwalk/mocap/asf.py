@@ -87,7 +87,9 @@ def _root_line(tok: list[str], root: Bone, where: str) -> np.ndarray | None:
     return None
 
 
-def _bone_line(tok: list[str], bone: Bone | None, bones: dict[str, Bone], where: str):
+def _bone_line(
+    tok: list[str], bone: Bone | None, bones: dict[str, Bone], where: str
+) -> Bone | None:
     key = tok[0].lower()
     if key == "begin":
         return Bone("")
@@ -135,7 +137,9 @@ def _units(tok: list[str], where: str) -> tuple[str, float]:
     return key, 0.0
 
 
-def _ordered(root: Bone, bones: dict[str, Bone], lines: list[tuple[int, list[str]]], src: str):
+def _ordered(
+    root: Bone, bones: dict[str, Bone], lines: list[tuple[int, list[str]]], src: str
+) -> dict[str, Bone]:
     """Bones in hierarchy order (parents first) from the ``:hierarchy`` lines."""
     parent_of: dict[str, str] = {}
     kids: dict[str, list[str]] = {}

@@ -36,7 +36,7 @@ from imitwalk.mocap.orient import (
     decide_units,
     decide_up,
 )
-from imitwalk.mocap.roles import assign_sides, leg_chains, load_joint_names, name_roles
+from imitwalk.mocap.roles import LegChain, assign_sides, leg_chains, load_joint_names, name_roles
 from imitwalk.mocap.skeleton import Joint, children, forward_kinematics, moving_columns
 
 __all__ = ["UNITS", "read_bvh"]
@@ -75,7 +75,9 @@ def _upper_body(joints: list[Joint], pelvis: int, hips: list[int]) -> list[int]:
     return out
 
 
-def _legs(joints: list[Joint], pos: np.ndarray, named: dict[str, int], src: str):
+def _legs(
+    joints: list[Joint], pos: np.ndarray, named: dict[str, int], src: str
+) -> tuple[tuple[LegChain, LegChain] | None, list[int], int, list[int]]:
     """Leg joints by name if the names give them all, else the two chains by structure."""
     if all(k in named for k in LOWER_BODY):
         return None, [named[k] for k in _FEET], named["pelvis"], [named["l_hip"], named["r_hip"]]
@@ -204,7 +206,7 @@ def _leg_length(pos: np.ndarray, hips: list[int], knees: list[int], ankles: list
     return float(np.mean(out))
 
 
-def _knees(named: dict[str, int], chains) -> list[int]:
+def _knees(named: dict[str, int], chains: tuple[LegChain, LegChain] | None) -> list[int]:
     if chains is None:
         return [named["l_knee"], named["r_knee"]]
     return [c.knee for c in chains]
@@ -216,7 +218,9 @@ def _centre(joints: list[Joint], pos: np.ndarray, pelvis: int, hips: list[int]) 
     return pos[:, upper].mean(axis=1) if upper else pos[:, pelvis]
 
 
-def _check_used(values: np.ndarray, channels, used: np.ndarray, rows: np.ndarray, src: str):
+def _check_used(
+    values: np.ndarray, channels: tuple[str, ...], used: np.ndarray, rows: np.ndarray, src: str
+) -> None:
     """A non-finite value in a channel that moves a keypoint -> MocapError naming its line."""
     bad = ~np.isfinite(values) & used
     if bad.any():

@@ -129,7 +129,9 @@ def _header(lines: list[str], i: int, want: str, src: str) -> tuple[str, int]:
     return v.strip(), i
 
 
-def _motion(lines: list[str], start: int, n_chan: int, src: str):
+def _motion(
+    lines: list[str], start: int, n_chan: int, src: str
+) -> tuple[np.ndarray, float, np.ndarray]:
     """Parse MOTION from line index ``start``: ``(T, C)`` values, dt [s], row line numbers."""
     frames, i = _header(lines, start + 1, "Frames", src)
     n_frames = count(frames, f"{src}: line {i + 1}", "Frames:", 0, MAX_FRAMES)

@@ -76,7 +76,9 @@ def _chord(joint: np.ndarray, wand: np.ndarray, prox: np.ndarray, offset: float)
     return joint + offset * (cos * a + np.sqrt(1.0 - cos**2) * medial)
 
 
-def _hip_centres(lasi, rasi, back) -> tuple[np.ndarray, np.ndarray]:
+def _hip_centres(
+    lasi: np.ndarray, rasi: np.ndarray, back: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Harrington (2007) hip centres [mm] from ASIS markers and mid-PSIS/SACR (``(T, 3)``)."""
     origin = (lasi + rasi) / 2
     z = rasi - lasi

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.navigate.course import Course
+from imitwalk.sim.types import Observation
 from imitwalk.step.controller import SteppingController
 from imitwalk.step.odometry import StepCommand
 from imitwalk.step.schedule import START_STEPS
@@ -122,7 +123,7 @@ class Navigator:
         self.stride += min(max(want - self.stride, -self._ramp), self._ramp)
         return StepCommand(heading=heading, stride=self.stride)
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         if k > 0 and self.ctrl.started:
             self.ctrl.steer(self._command())
         q = self.ctrl(k, obs)

@@ -10,6 +10,7 @@ within the course's ``reach`` of it. Many robots walk in parallel
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,10 +19,13 @@ from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.fix import FixSensor, PositionFix
 from imitwalk.sim.metrics import yaw_rad
-from imitwalk.sim.types import Rollout, SimOptions
+from imitwalk.sim.types import Observation, Rollout, SimOptions
 from imitwalk.step.gains import StepGains
 from imitwalk.step.odometry import rot2
 from imitwalk.step.style import GaitStyle
+
+if TYPE_CHECKING:
+    from imitwalk.navigate.navigator import Navigator
 
 __all__ = ["NavJob", "NavResult", "run_nav_job", "start_frame", "truth_path", "walk_course"]
 
@@ -126,7 +130,7 @@ def _reached(path: np.ndarray, t: np.ndarray, course: Course) -> list[float | No
     return out
 
 
-def walk_course(job: NavJob):
+def walk_course(job: NavJob) -> tuple[NavResult, Navigator, Rollout]:
     """Walk ``job``: its :class:`NavResult`, the navigator and the rollout."""
     from imitwalk.navigate.navigator import Navigator
     from imitwalk.sim.mujoco import make_plant, run
@@ -137,7 +141,7 @@ def walk_course(job: NavJob):
     plant = make_plant(job.robot, replace(job.options, control_hz=1.0 / job.dt))
     sensor = FixSensor(job.fix, job.seed) if job.fix is not None else None
 
-    def policy(k: int, obs) -> np.ndarray:
+    def policy(k: int, obs: Observation) -> np.ndarray:
         if sensor is not None and (xy := sensor.read(plant, float(obs.t))) is not None:
             nav.fix(xy)
         return nav(k, obs)

@@ -20,12 +20,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from sklearn.exceptions import NotFittedError
 from sklearn.utils.validation import check_is_fitted
 
 from imitwalk.errors import ConfigError
+
+if TYPE_CHECKING:
+    from imitwalk.paper.embedding import GaitEmbedding
 
 __all__ = ["ActionSelector", "Decision", "SearchProblem", "stability_cost"]
 
@@ -86,6 +90,21 @@ def _midpoints(n: int) -> np.ndarray:
     return (2.0 * np.arange(n) + 1.0) / n - 1.0
 
 
+class _Model(Protocol):
+    """What the search needs of a sensory-motor model: a fitted
+    :class:`~imitwalk.paper.predictor.SensoryMotorModel`, or anything alike."""
+
+    @property
+    def n_state_(self) -> int: ...
+
+    @property
+    def n_action_(self) -> int: ...
+
+    def rollout(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, actions: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray: ...
+
+
 class ActionSelector:
     """Model-predictive action search, eqs. (5)–(13).
 
@@ -104,8 +123,8 @@ class ActionSelector:
 
     def __init__(
         self,
-        embedding,
-        model,
+        embedding: GaitEmbedding,
+        model: _Model,
         *,
         weights: Sequence[float] = (1.0, 1.0, 1.0),
         eps_phi: float,
@@ -160,7 +179,7 @@ class ActionSelector:
         off = (2.0 * u[:, 1:] - 1.0) * (self.eps_r, self.eps_h)  # [−ε, ε)
         return dphi, g(phi_prev + dphi), off
 
-    def build(self, s_t, s_tm1, a_tm1) -> SearchProblem:
+    def build(self, s_t: np.ndarray, s_tm1: np.ndarray, a_tm1: np.ndarray) -> SearchProblem:
         """Candidates in the box of eqs. (9)–(13), their predicted states and Γ costs.
 
         Args:
@@ -216,11 +235,11 @@ class ActionSelector:
             n_candidates=len(costs),
         )
 
-    def select(self, s_t, s_tm1, a_tm1) -> Decision:
+    def select(self, s_t: np.ndarray, s_tm1: np.ndarray, a_tm1: np.ndarray) -> Decision:
         """:meth:`build` then :meth:`solve`."""
         return self.solve(self.build(s_t, s_tm1, a_tm1))
 
-    def to_posture(self, action) -> np.ndarray:
+    def to_posture(self, action: np.ndarray) -> np.ndarray:
         """Action (φ, r, h) to its ``(k,)`` posture-subspace point through the embedding;
         :meth:`~imitwalk.paper.subspace.PostureSubspace.inverse_transform` (C⁺) then gives the
         joint targets [rad]."""

@@ -194,7 +194,7 @@ class GaitEmbedding(BaseEstimator):
         phi = self._grid_phi[np.argmin(d2, axis=1)]
         step = self._grid_phi[1]
 
-        def f(p):
+        def f(p: np.ndarray) -> np.ndarray:
             return np.angle(np.exp(1j * (self._theta(p) - theta)))
 
         lo, hi = phi - step, phi + step

@@ -8,6 +8,7 @@ judgement reports.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from scipy.stats import binomtest
@@ -15,6 +16,7 @@ from scipy.stats import binomtest
 from imitwalk.paper.gait import GaitModel
 from imitwalk.paper.learnconfig import LearnConfig
 from imitwalk.paper.models import build_policy, fit_model, unstack_episodes
+from imitwalk.paper.policy import WalkPolicy
 from imitwalk.retarget.reference import Reference
 from imitwalk.runs import LearnSummary, RunDir
 
@@ -30,13 +32,13 @@ class LearnedGait:
         self.gait = GaitModel(ref, config.schedule.scales(), config.gait)
         self.model = fit_model(data, config)
 
-    def policy(self, scale: float | None = None):
+    def policy(self, scale: float | None = None) -> WalkPolicy:
         """A fresh controller (no exploration) at ``scale`` (default: the scale reached)."""
         s = self.scale if scale is None else scale
         return build_policy(self.gait, s, self.config, self.model)
 
 
-def load_gait(run_dir) -> LearnedGait:
+def load_gait(run_dir: str | Path) -> LearnedGait:
     """Rebuild the learned controller of a finished faithful run folder."""
     from imitwalk.config import from_dict
 

@@ -9,7 +9,7 @@ learner is the per-tick balance learner (:mod:`imitwalk.balance.ticklearn`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 from imitwalk.config import schedule_scales
@@ -17,7 +17,7 @@ from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.paper.gait import GaitConfig
 from imitwalk.sim.types import ENGINES
 
-__all__ = ["VARIANTS", "LearnConfig", "ScheduleConfig", "TickConfig", "preset"]
+__all__ = ["LearnConfig", "ScheduleConfig", "TickConfig"]
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,6 @@ class LearnConfig:
     """Everything a faithful learning run depends on (with the seed, it fixes the result).
 
     Attributes:
-        variant: the preset these settings started from (a label).
         gait: representation; schedule: scales; tick: the paper's per-tick search.
         train_models: robots per iteration: the nominal one + training perturbations.
         seed: random seed; workers: parallel processes (``None``: one per core).
@@ -81,7 +80,6 @@ class LearnConfig:
 
     CHOICES: ClassVar[dict] = {"engine": ENGINES}
 
-    variant: str = "faithful"
     gait: GaitConfig = field(default_factory=GaitConfig)
     schedule: ScheduleConfig = field(default_factory=ScheduleConfig)
     tick: TickConfig = field(default_factory=TickConfig)
@@ -90,18 +88,8 @@ class LearnConfig:
     workers: int | None = None
     engine: str = "mujoco"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.engine not in ENGINES:
             raise unknown_name("engine", self.engine, ENGINES, ConfigError)
         if self.train_models < 1:
             raise ConfigError(f"train_models={self.train_models}: expected at least 1")
-
-
-VARIANTS: dict[str, LearnConfig] = {"faithful": LearnConfig()}
-
-
-def preset(name: str, **changes) -> LearnConfig:
-    """The named variant's settings, with ``changes`` applied."""
-    if name not in VARIANTS:
-        raise unknown_name("variant", name, VARIANTS, ConfigError)
-    return replace(VARIANTS[name], **changes)

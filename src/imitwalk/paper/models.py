@@ -8,6 +8,8 @@ so a run folder holds everything needed to rebuild the controller.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from imitwalk.paper.controller import ActionSelector
@@ -49,7 +51,7 @@ def build_policy(
     config: LearnConfig,
     model: SensoryMotorModel | None,
     explore: float = 0.0,
-    rng_seed=None,
+    rng_seed: int | Sequence[int] | None = None,
 ) -> WalkPolicy:
     """The paper's controller at ``scale`` (the nominal actions until there is a model)."""
     rng = np.random.default_rng(rng_seed) if explore > 0 else None

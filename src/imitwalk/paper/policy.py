@@ -14,6 +14,7 @@ import numpy as np
 
 from imitwalk.paper.controller import ActionSelector
 from imitwalk.paper.gait import GaitModel
+from imitwalk.sim.types import Observation
 
 __all__ = ["WalkPolicy"]
 
@@ -58,7 +59,7 @@ class WalkPolicy:
         :func:`imitwalk.sim.mujoco.run` resets the robot to it."""
         return self.start[0]
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         m, n = len(self.start), self.n
         if k < self.first_loop_tick:
             return self.start[k].copy()

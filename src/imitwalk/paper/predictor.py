@@ -95,7 +95,9 @@ class SensoryMotorModel(BaseEstimator):
         self.predict_delta = predict_delta
         self.random_state = random_state
 
-    def _tuples(self, episodes: Sequence[Episode]):
+    def _tuples(
+        self, episodes: Sequence[Episode]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int]]:
         """α ``(N, p)``, s_t ``(N, ds)``, s_{t+1} ``(N, ds)`` over all episodes, and (ds, da)."""
         if self.order not in (1, 2):
             raise ConfigError(f"order must be 1 or 2, got {self.order!r}")
@@ -119,7 +121,9 @@ class SensoryMotorModel(BaseEstimator):
             raise ValueError(f"no episode is longer than order={n} ticks")
         return np.vstack(alphas), np.vstack(cur), np.vstack(nxt), dims.pop()
 
-    def _alpha(self, s_t, s_tm1, a_t, a_tm1) -> np.ndarray:
+    def _alpha(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, a_t: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray:
         """Network input α, eq. (4): ``(M, 2 ds + 2 (da + 1))`` (order 1: half of it)."""
         enc = encode_action if self.angle_action else (lambda a: np.asarray(a, dtype=float))
         if self.order == 1:
@@ -146,11 +150,15 @@ class SensoryMotorModel(BaseEstimator):
         self.n_samples_ = len(alpha)
         return self
 
-    def _f(self, s_t, s_tm1, a_t, a_tm1) -> np.ndarray:
+    def _f(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, a_t: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray:
         out = self.network_.predict(self._alpha(s_t, s_tm1, a_t, a_tm1))  # (M, ds)
         return out + s_t if self.predict_delta else out
 
-    def predict(self, s_t, s_tm1, a_t, a_tm1) -> np.ndarray:
+    def predict(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, a_t: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray:
         """s_{t+1} = F(s_t, s_{t−1}, a_t, a_{t−1}), eq. (3), vectorised over candidates.
 
         Args:
@@ -169,7 +177,9 @@ class SensoryMotorModel(BaseEstimator):
         out = self._f(s_t, s_tm1, a_t, a_tm1)
         return out[0] if one else out
 
-    def rollout(self, s_t, s_tm1, actions, a_tm1) -> np.ndarray:
+    def rollout(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, actions: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray:
         """Multi-step prediction feeding each prediction back as the next state.
 
         Args:
@@ -191,7 +201,9 @@ class SensoryMotorModel(BaseEstimator):
             s, s_prev, a_prev = out[:, h], s, actions[:, h]
         return out
 
-    def rollout_members(self, s_t, s_tm1, actions, a_tm1) -> np.ndarray:
+    def rollout_members(
+        self, s_t: np.ndarray, s_tm1: np.ndarray, actions: np.ndarray, a_tm1: np.ndarray
+    ) -> np.ndarray:
         """:meth:`rollout` as a one-member ensemble: ``(1, M, H, ds)``
         (the interface of :class:`~imitwalk.ensemble.ModelEnsemble`)."""
         return self.rollout(s_t, s_tm1, actions, a_tm1)[None]

@@ -58,7 +58,7 @@ class PostureSubspace(TransformerMixin, BaseEstimator):
     def __init__(self, n_components: int = 3):
         self.n_components = n_components
 
-    def fit(self, Q: np.ndarray | Sequence[np.ndarray], y=None) -> PostureSubspace:
+    def fit(self, Q: np.ndarray | Sequence[np.ndarray], y: object = None) -> PostureSubspace:
         """Fit the subspace.
 
         Args:
@@ -82,7 +82,7 @@ class PostureSubspace(TransformerMixin, BaseEstimator):
         self.n_features_in_ = Q.shape[1]
         return self
 
-    def fit_transform(self, Q: np.ndarray | Sequence[np.ndarray], y=None) -> np.ndarray:
+    def fit_transform(self, Q: np.ndarray | Sequence[np.ndarray], y: object = None) -> np.ndarray:
         """:meth:`fit`, then :meth:`transform` of the stacked data: ``(ΣT, k)``."""
         return self.fit(Q).transform(_stack(Q))
 

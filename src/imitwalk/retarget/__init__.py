@@ -13,7 +13,7 @@ it without the IK and MuJoCo. :func:`retarget` itself lives in
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 __all__ = [
     "MAPPINGS",
@@ -52,7 +52,7 @@ if TYPE_CHECKING:  # for type checkers and editors; at run time, __getattr__ bel
     from imitwalk.retarget.template import GaitTemplate, extract_template
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     if name not in _HOME:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     value = getattr(importlib.import_module(f"{__name__}.{_HOME[name]}"), name)

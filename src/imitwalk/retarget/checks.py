@@ -12,7 +12,9 @@ from imitwalk.robots import Robot
 __all__ = ["kinematic_checks", "sole_pose"]
 
 
-def sole_pose(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+def sole_pose(
+    model: mujoco.MjModel, data: mujoco.MjData, name: str
+) -> tuple[np.ndarray, np.ndarray]:
     """Position ``(3,)`` [m] and rotation ``(3, 3)`` of the sole ``name`` (a site, else a
     body; :attr:`~imitwalk.robots.Robot.soles`) in ``data``, after kinematics."""
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:

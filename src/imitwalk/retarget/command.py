@@ -112,7 +112,7 @@ class GaitCommand:
     forward: float = 1.0
     slope_deg: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name, (lo, hi) in LIMITS.items():
             v = getattr(self, name)
             if name == "side_m":  # scaled with the robot's leg: checked by check_side

@@ -21,6 +21,7 @@ joint angles are, and the learner picks how much of it to add
 from __future__ import annotations
 
 import hashlib
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -28,6 +29,9 @@ from scipy.ndimage import gaussian_filter1d
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.reference import Reference
+
+if TYPE_CHECKING:
+    from imitwalk.robots import Robot
 
 __all__ = ["CLIP", "SMOOTH", "reference_offsets", "servo_offsets", "walk_offsets"]
 
@@ -37,7 +41,7 @@ SMOOTH, CLIP = 2.0, 0.2
 _CACHE: dict[tuple, tuple[np.ndarray, np.ndarray, dict]] = {}
 
 
-def _servo_gains(m, jid: list[int]) -> tuple[np.ndarray, np.ndarray]:
+def _servo_gains(m: mujoco.MjModel, jid: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """``(n,)`` kp [Nm/rad] and kv [Nm·s/rad] of each joint's position servo (0: none)."""
     kp, kv = np.zeros(len(jid)), np.zeros(len(jid))
     for a in range(m.nu):
@@ -48,7 +52,7 @@ def _servo_gains(m, jid: list[int]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def servo_offsets(
-    robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarray, dt: float
+    robot: Robot, q_ref: np.ndarray, stance: np.ndarray, share: np.ndarray, dt: float
 ) -> np.ndarray:
     """``(T, n)`` target offsets [rad] so that the nominal servos give the reference's torques.
 
@@ -101,7 +105,7 @@ def servo_offsets(
     return np.clip(out, -CLIP, CLIP)
 
 
-def _cycles(ref: Reference, robot, scale: float) -> tuple[np.ndarray, np.ndarray, dict]:
+def _cycles(ref: Reference, robot: Robot, scale: float) -> tuple[np.ndarray, np.ndarray, dict]:
     """:func:`servo_offsets` of the start-up and first loop ``(M + N, n)``, and of one
     loop in the steady walk ``(N, n)`` (the second of three, clear of both ends' finite
     differences): every later cycle repeats it. Computed once per reference, scale and
@@ -118,7 +122,7 @@ def _cycles(ref: Reference, robot, scale: float) -> tuple[np.ndarray, np.ndarray
     return _CACHE[key]
 
 
-def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np.ndarray:
+def reference_offsets(ref: Reference, robot: Robot, scale: float, seconds: float) -> np.ndarray:
     """``(T, n)`` :func:`servo_offsets` of ``ref`` at ``scale`` for ``seconds`` (``T`` the
     ticks of :meth:`Reference.trajectory`), on ``robot``'s nominal model: the start-up and
     first loop as computed, then the steady loop repeated (:meth:`Reference.loop_index`),
@@ -141,7 +145,9 @@ def reference_offsets(ref: Reference, robot, scale: float, seconds: float) -> np
     return walks[T]
 
 
-def walk_offsets(ref: Reference, robot, scale: float, seconds: float, fraction: float):
+def walk_offsets(
+    ref: Reference, robot: Robot, scale: float, seconds: float, fraction: float
+) -> np.ndarray | None:
     """``fraction`` × :func:`reference_offsets` for a walk of ``seconds`` whose clock may
     wait (``(T', n)``, ``T'`` the ticks of twice as long), or ``None`` at a fraction of 0."""
     if not fraction:

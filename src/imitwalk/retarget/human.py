@@ -10,6 +10,8 @@ paper's too: the joint pattern is shrunk about its mean.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import mink
 import mujoco
 import numpy as np
@@ -132,7 +134,11 @@ def human_ik(motion: Motion, robot: Robot, frames: np.ndarray) -> tuple[np.ndarr
 
 
 def build_paper(
-    motion: Motion, template: GaitTemplate, robot: Robot, scales, dt: float
+    motion: Motion,
+    template: GaitTemplate,
+    robot: Robot,
+    scales: Sequence[float] | np.ndarray,
+    dt: float,
 ) -> Reference:
     """The paper's reference: one human cycle retargeted, shrunk about its mean per scale."""
     a, b = template.cycles[0]

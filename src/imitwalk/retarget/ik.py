@@ -31,12 +31,12 @@ def _frame(model: mujoco.MjModel, name: str) -> tuple[str, int]:
     return "body", model.body(name).id
 
 
-def _pos(model, data, name: str) -> np.ndarray:
+def _pos(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
     kind, i = _frame(model, name)
     return (data.site_xpos if kind == "site" else data.xpos)[i].copy()
 
 
-def _mat(model, data, name: str) -> np.ndarray:
+def _mat(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
     kind, i = _frame(model, name)
     return (data.site_xmat if kind == "site" else data.xmat)[i].reshape(3, 3).copy()
 

@@ -99,7 +99,7 @@ class _ArraysOnly(pickle.Unpickler):
         ("builtins", "int"),
     }
 
-    def find_class(self, module: str, name: str):
+    def find_class(self, module: str, name: str) -> Any:
         if (module, name) not in self.ALLOWED:
             raise MocapError(f"it holds a {module}.{name}: a GMR file holds arrays only")
         return super().find_class(module, name)
@@ -189,7 +189,7 @@ def read_robot_motion(path: str | Path, robot: Robot) -> RobotMotion:
     return _read_gmr(p, robot) if fmt == "gmr" else _read_locomujoco(p, robot)
 
 
-def load_clip(path: str | Path, robot: Robot, **mocap) -> Motion:
+def load_clip(path: str | Path, robot: Robot, **mocap: Any) -> Motion:
     """A clip to learn from: a mocap file (:func:`~imitwalk.mocap.load_motion`, with
     ``mocap``'s options), or a robot-motion file of ``robot`` (GMR, LocoMuJoCo) as the
     joint centres its forward kinematics give

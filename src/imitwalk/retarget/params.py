@@ -14,7 +14,7 @@ __all__ = ["LIFT", "REFERENCE_LEG", "GaitParams", "LegGeometry", "leg_scaled"]
 
 #: The leg (hip to ankle) [m] that every length in the reference's tables is written
 #: for: the default lift below, the search ranges (:data:`imitwalk.retarget.search.BOUNDS`),
-#: the refinement's nudges and the least gap between the feet. They were set on hoap2,
+#: and the least gap between the feet. They were set on hoap2,
 #: whose leg this is; a robot with another leg has them scaled by its own over this one
 #: (:func:`leg_scaled`), so a robot three times as tall lifts its feet three times as high.
 REFERENCE_LEG = 0.2

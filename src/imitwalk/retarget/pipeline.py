@@ -9,23 +9,24 @@ module runs the IK and the trials, so it imports MuJoCo (through the solvers).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.mocap.motion import Motion
-from imitwalk.retarget.cadence import with_cadence
 from imitwalk.retarget.command import GaitCommand, check_side
 from imitwalk.retarget.human import build_paper
 from imitwalk.retarget.ik import leg_geometry
 from imitwalk.retarget.plan import GaitParams
+from imitwalk.retarget.provenance import Provenance
 from imitwalk.retarget.reference import Reference
-from imitwalk.retarget.refine import refine_params, refine_per_scale
 from imitwalk.retarget.search import SearchConfig, Walker, search_params
+from imitwalk.retarget.searchreport import SearchReport
 from imitwalk.retarget.template import GaitTemplate, extract_template
-from imitwalk.retarget.walkable import build_walkable, off_grid
+from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
 
 __all__ = [
@@ -51,9 +52,6 @@ class RetargetConfig:
         search_config: the search's budget.
         command: turn, sidestep, stride fraction and slope
             (:class:`~imitwalk.retarget.command.GaitCommand`; default straight, level).
-        cadence: play the loop this many times as fast as the human walked
-            (:func:`~imitwalk.retarget.cadence.with_cadence`; the search still runs at
-            the human's cadence). 1: the human's own.
     """
 
     CHOICES: ClassVar[dict] = {"mapping": MAPPINGS}
@@ -64,7 +62,6 @@ class RetargetConfig:
     search: bool = True
     params: GaitParams = field(default_factory=GaitParams)
     search_config: SearchConfig = field(default_factory=SearchConfig)
-    cadence: float = 1.0
     command: GaitCommand = field(default_factory=GaitCommand)
 
     @property
@@ -100,28 +97,22 @@ class RetargetResult:
             "human_speed_mps": self.template.speed,
             "mapping": ref.mapping,
             "reference_frames": int(ref.loops.shape[1]),
-            "cadence": float(ref.settings.get("cadence", 1.0)),
             "reference_hz": 1.0 / ref.dt,
             "ik_residual_mm_mean": float(ref.residual_mm.mean()),
             "ik_residual_mm_max": float(ref.residual_mm.max()),
             "clipped_fraction": at_limit / total if total else 0.0,
             "clipped": ref.clipped,
             "frames_per_second_solved": self.frames_solved / max(self.solve_seconds, 1e-9),
-            "params": ref.params,
+            "params": ref.params.to_dict() if ref.params is not None else {},
         }
-        if ref.scale_params:
-            out["scale_params"] = ref.scale_params
         out.update({k: v for k, v in ref.checks.items() if k != "scale"})
-        if ref.search.get("best"):
-            s = ref.search
-            out["search"] = {k: s[k] for k in ("evaluations", "sim_seconds", "wall_seconds")}
-            out["search"]["best_score"] = s["best"]["score"]
-        if "refine" in ref.search:
-            r = ref.search["refine"]
-            keys = ("scales", "start_falls", "falls", "sim_seconds", "wall_seconds")
-            out["refine"] = {k: r[k] for k in keys}
-            out["refine"]["runs_per_trial"] = r["trials"][0]["robots"]
-            out["refine"]["trials"] = len(r["trials"])
+        if (s := ref.search) is not None:
+            out["search"] = {
+                "evaluations": s.evaluations,
+                "sim_seconds": s.sim_seconds,
+                "wall_seconds": s.wall_seconds,
+                "best_score": s.best_score,
+            }
         return out
 
 
@@ -129,8 +120,7 @@ def retarget(
     motion: Motion,
     robot: Robot,
     config: RetargetConfig | None = None,
-    progress=None,
-    refine_progress=None,
+    progress: Callable[[int, int, float, dict], None] | None = None,
     walker: Walker | None = None,
 ) -> RetargetResult:
     """Retarget ``motion`` to ``robot``.
@@ -139,8 +129,7 @@ def retarget(
         motion: a loaded clip (see :func:`imitwalk.mocap.load_motion`).
         robot: the robot.
         config: settings; progress: optional ``callback(generation, total, score, params)``
-            for the parameter search; refine_progress: optional ``callback(done, total,
-            trial)`` for its refinement (``search_config.refine_rounds``); walker: the
+            for the parameter search; walker: the
             search walks its candidates under a controller
             (:data:`~imitwalk.retarget.search.Walker`; ``None``: open loop).
 
@@ -150,11 +139,6 @@ def retarget(
     cfg = config or RetargetConfig()
     if cfg.mapping not in MAPPINGS:
         raise unknown_name("mapping", cfg.mapping, MAPPINGS, ConfigError)
-    sc = cfg.search_config
-    if cfg.searches and sc.refine_rounds and sc.refine_per_scale:
-        if off := off_grid(cfg.scales, sc.refine_scales):
-            grid = ", ".join(f"{x:g}" for x in cfg.scales)
-            raise ConfigError(f"search_config.refine_scales {off}: not grid scales ({grid})")
     template = extract_template(motion, allow_turn=bool(cfg.command.turn_deg))
     dt = 1.0 / cfg.control_hz
     t0 = time.perf_counter()
@@ -163,12 +147,12 @@ def retarget(
     if cfg.mapping == "paper":
         ref = build_paper(motion, template, robot, cfg.scales, dt)
         frames, seconds = ref.loops.shape[1], time.perf_counter() - t0
-        report: dict = {}
+        report: SearchReport | None = None
     else:
         leg = leg_geometry(robot).leg
         check_side(cfg.command, leg)  # before any search: the sidestep scales with the leg
         # a lift left unset is a tenth of this robot's leg
-        params, report, own = cfg.params.for_leg(leg), {}, None
+        params, report = cfg.params.for_leg(leg), None
         if cfg.searches:
             params, report = search_params(
                 template,
@@ -180,36 +164,18 @@ def retarget(
                 command=cfg.command,
                 walker=walker,
             )
-            if sc.refine_rounds:
-                how = refine_per_scale if sc.refine_per_scale else refine_params
-                out, report["refine"] = how(
-                    template,
-                    robot,
-                    params,
-                    sc,
-                    dt=dt,
-                    command=cfg.command,
-                    progress=refine_progress,
-                )
-                if isinstance(out, GaitParams):
-                    params = out
-                else:
-                    own = out
-        build = build_walkable(
-            template, robot, params, cfg.scales, dt, command=cfg.command, scale_params=own
-        )
+        build = build_walkable(template, robot, params, cfg.scales, dt, command=cfg.command)
         ref, frames, seconds = build.reference, build.frames, build.seconds
-    ref.search = report
-    ref.source = motion.source
-    ref.cycles = np.array(template.cycles, dtype=int).reshape(-1, 2)
-    ref.settings = {
-        "mapping": cfg.mapping,
-        "control_hz": cfg.control_hz,
-        "scales": list(cfg.scales),
-        "search": cfg.search,
-        "motion_format": motion.format,
-        "motion_fps": motion.fps,
-        "filled": list(motion.filled),
-    }
-    ref = with_cadence(ref, cfg.cadence)
+    ref = replace(
+        ref,
+        search=report,
+        source=motion.source,
+        cycles=np.array(template.cycles, dtype=int).reshape(-1, 2),
+        provenance=Provenance(
+            searched=cfg.search,
+            motion_format=motion.format,
+            motion_fps=motion.fps,
+            filled=tuple(motion.filled),
+        ),
+    )
     return RetargetResult(ref, motion.n_frames, motion.fps, template, frames, seconds)

@@ -9,9 +9,9 @@ the reference parameters and the search that found them, and where it came from.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields, is_dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,10 +19,19 @@ from imitwalk.errors import RunError
 from imitwalk.fileio import write_npz
 from imitwalk.readback import FORMAT_KEY
 from imitwalk.retarget.command import GaitCommand, advance
+from imitwalk.retarget.params import GaitParams
+from imitwalk.retarget.provenance import Provenance
 from imitwalk.retarget.reffile import REFERENCE_FORMAT, read_reference_file
+from imitwalk.retarget.searchreport import SearchReport
 from imitwalk.sim.types import SimOptions
 
+if TYPE_CHECKING:
+    from imitwalk.retarget.plan import TaskPlan
+
 __all__ = ["PLAN_KEYS", "Reference", "plan_arrays"]
+
+#: The fields a reference file stores as JSON objects of their own shape.
+_TYPED = frozenset({"params", "search", "command", "provenance", "plan"})
 
 #: Arrays of a stored task-space plan (upper-body roles in :data:`UPPER`; ``yaw`` and
 #: ``path`` as in :class:`~imitwalk.retarget.plan.TaskPlan`; references written before
@@ -31,8 +40,9 @@ PLAN_KEYS = ("l_sole", "r_sole", "com", "pelvis_z", "upper", "yaw", "path")
 UPPER = ("l_shoulder_pitch", "r_shoulder_pitch", "l_elbow", "r_elbow", "waist_yaw")
 
 
-def plan_arrays(plan) -> dict[str, np.ndarray]:
+def plan_arrays(plan: TaskPlan) -> dict[str, np.ndarray]:
     """A :class:`~imitwalk.retarget.plan.TaskPlan` as the arrays a reference stores."""
+    assert plan.yaw is not None and plan.path is not None  # plan_walk sets both
     upper = np.stack([plan.upper.get(u, np.zeros(len(plan.phase))) for u in UPPER], axis=1)
     return {
         "l_sole": plan.l_sole,
@@ -45,9 +55,10 @@ def plan_arrays(plan) -> dict[str, np.ndarray]:
     }
 
 
-@dataclass
+@dataclass(frozen=True)
 class Reference:
-    """A robot gait retargeted from mocap.
+    """A robot gait retargeted from mocap, built once (a frozen record: a changed copy is
+    :func:`dataclasses.replace`'s).
 
     Attributes:
         robot: robot name; joint_names: ``n`` roles, the columns of every trajectory.
@@ -63,16 +74,15 @@ class Reference:
         residual_mm: ``(S, M + N)`` worst IK task error per tick [mm].
         clipped: one dict per (scale, joint) that sat on a joint limit.
         checks: kinematic checks of the largest scale (tilt, clearance, closure, skate).
-        params: the reference parameters; search: the report of the search for them.
-        scale_params: other parameters at some grid scales (``{"1": {...}}``; empty:
-            ``params`` at every scale); see :meth:`params_at`.
-        source: the mocap file; settings: how it was retargeted; cycles: ``(C, 2)``
-            source frames of the gait cycles used.
+        params: the reference parameters (``None``: the paper's mapping has none);
+            search: the report of the search for them (``None``: not searched).
+        source: the mocap file; cycles: ``(C, 2)`` source frames of the gait cycles
+            used; provenance: the clip as it was read and the robot as it was named.
         plan: the task-space plan the walkable IK solved, per scale and tick of the
             start-up and loop (``(S, M + N, ...)`` arrays named by :data:`PLAN_KEYS`);
             empty for the paper's mapping. The balance channels re-solve it with offsets.
         command: the :class:`~imitwalk.retarget.command.GaitCommand` it was built for
-            (empty: straight ahead on level ground).
+            (the default: straight ahead on level ground).
         motion: ``(S, 5)`` how one loop moves the walking frame, per scale
             (:func:`~imitwalk.retarget.command.cycle_motion`); empty: one stride ahead.
     """
@@ -90,17 +100,16 @@ class Reference:
     phase: np.ndarray
     stance: np.ndarray
     residual_mm: np.ndarray
-    clipped: list = field(default_factory=list)
-    checks: dict = field(default_factory=dict)
-    params: dict = field(default_factory=dict)
-    search: dict = field(default_factory=dict)
+    clipped: list[dict[str, Any]] = field(default_factory=list)
+    checks: dict[str, Any] = field(default_factory=dict)
+    params: GaitParams | None = None
+    search: SearchReport | None = None
     source: str = ""
-    settings: dict = field(default_factory=dict)
+    provenance: Provenance = field(default_factory=Provenance)
     cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
-    plan: dict = field(default_factory=dict)
-    command: dict = field(default_factory=dict)
+    plan: dict[str, np.ndarray] = field(default_factory=dict)
+    command: GaitCommand = field(default_factory=GaitCommand)
     motion: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
-    scale_params: dict = field(default_factory=dict)
 
     # -- access ---------------------------------------------------------------
     def _bracket(self, scale: float) -> tuple[int, int, float]:
@@ -121,11 +130,6 @@ class Reference:
         i, j, w = self._bracket(scale)
         mix = lambda a: (1.0 - w) * a[i] + w * a[j]  # noqa: E731
         return mix(self.starts), mix(self.loops), float(mix(self.strides))
-
-    def params_at(self, scale: float) -> dict:
-        """The reference parameters the nearest grid scale to ``scale`` was solved with."""
-        near = self.scales[int(np.argmin(np.abs(self.scales - scale)))]
-        return self.scale_params.get(f"{near:g}", self.params)
 
     def plan_at(self, scale: float) -> dict[str, np.ndarray]:
         """The task-space plan ``(M + N, ...)`` arrays at ``scale`` (blended between grid
@@ -164,7 +168,7 @@ class Reference:
         one = np.where(down[:, 1] & ~down[:, 0], 0.0, share)
         return down, np.where(down[:, 0] & ~down[:, 1], 1.0, one)
 
-    def loop_index(self, k):
+    def loop_index(self, k: int | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Where tick ``k`` from standing (int or int array) falls in the stored start-up
         and loop: the stored tick ``i`` and how many whole cycles ``c`` the loop has been
         repeated before it (0 within the stored ticks)."""
@@ -204,15 +208,11 @@ class Reference:
         dy = d[:, 0] * np.sin(h) + d[:, 1] * np.cos(h)
         return np.stack([np.cumsum(dx), np.cumsum(dy)], axis=1)
 
-    def gait_command(self) -> GaitCommand:
-        """The command the reference was built for."""
-        return GaitCommand.from_dict(self.command)
-
     def sim_options(self, base: SimOptions | None = None) -> SimOptions:
         """``base`` (default options if ``None``) on the ground the gait was built for:
         the command's slope added to ``base``'s own."""
         base = base or SimOptions()
-        slope = float(self.command.get("slope_deg", 0.0)) if self.command else 0.0
+        slope = self.command.slope_deg
         return replace(base, slope_deg=base.slope_deg + slope) if slope else base
 
     def trajectory(self, scale: float, seconds: float) -> np.ndarray:
@@ -240,16 +240,23 @@ class Reference:
     def save(self, path: str | Path) -> Path:
         """Write ``path`` (``.npz``) atomically, its metadata of format
         :data:`~imitwalk.retarget.reffile.REFERENCE_FORMAT`."""
-        arrays = {}
-        meta = {}
+        arrays: dict[str, np.ndarray] = {f"plan_{k}": a for k, a in self.plan.items()}
+        meta: dict[str, Any] = {}
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name == "plan":
-                arrays.update({f"plan_{k}": a for k, a in v.items()})
-            elif isinstance(v, np.ndarray):
+            if isinstance(v, np.ndarray):
                 arrays[f.name] = v
-            else:
+            elif f.name not in _TYPED:
                 meta[f.name] = v
+        meta["params"] = self.params.to_dict() if self.params is not None else {}
+        meta["search"] = self.search.to_dict() if self.search is not None else {}
+        meta["command"] = self.command.to_dict()
+        meta["settings"] = {
+            "mapping": self.mapping,
+            "control_hz": 1.0 / self.dt,
+            "scales": self.scales.tolist(),
+            **self.provenance.to_settings(),
+        }
         arrays["q"] = self.loops[-1]  # the joint trajectory at the largest scale, (N, n)
         meta = {FORMAT_KEY: REFERENCE_FORMAT, **meta}
         arrays["meta_json"] = np.array(json.dumps(meta, default=_jsonable))
@@ -261,9 +268,18 @@ class Reference:
         the file and what is wrong if it is not one)."""
         meta, read = read_reference_file(path)
         plan = {k[5:]: read.pop(k) for k in list(read) if k.startswith("plan_")}
-        known = {f.name for f in fields(cls)}
+        known = {f.name for f in fields(cls)} - _TYPED
         arrays: dict[str, Any] = {k: v for k, v in read.items() if k in known}
-        return cls(**{k: v for k, v in meta.items() if k in known}, **arrays, plan=plan)
+        params = meta.get("params") or {}
+        return cls(
+            **{k: v for k, v in meta.items() if k in known},
+            **arrays,
+            plan=plan,
+            params=GaitParams(**params) if params else None,
+            search=SearchReport.from_dict(meta.get("search") or {}),
+            command=GaitCommand.from_dict(meta.get("command")),
+            provenance=Provenance.from_settings(meta.get("settings") or {}),
+        )
 
     def summary(self) -> dict:
         """Plain-JSON description (no per-tick arrays)."""
@@ -274,19 +290,18 @@ class Reference:
             "period_s": self.period,
             "scales": self.scales.tolist(),
             "strides_m": self.strides.tolist(),
-            "params": self.params,
-            **({"scale_params": self.scale_params} if self.scale_params else {}),
+            "params": self.params.to_dict() if self.params is not None else {},
             "checks": self.checks,
-            "command": self.gait_command().to_dict(),
+            "command": self.command.to_dict(),
             "source": self.source,
         }
 
 
-def _jsonable(v):
+def _jsonable(v: object) -> object:
     if isinstance(v, np.generic):
         return v.item()
     if isinstance(v, np.ndarray):
         return v.tolist()
-    if hasattr(v, "__dataclass_fields__"):
+    if is_dataclass(v) and not isinstance(v, type):
         return asdict(v)
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")

@@ -8,8 +8,10 @@ an ``.npz`` archive (:func:`~imitwalk.readback.read_npz`) holding:
 * metadata that is a JSON object of a ``format`` this imitwalk reads (up to
   :data:`REFERENCE_FORMAT`; none: a reference written before versions, format 1), with
   ``robot``, ``joint_names`` (``n`` strings), ``mapping``, ``dt`` and ``period``
-  (finite, above 0) [s], any optional field of its type, and a ``command`` that
-  :class:`~imitwalk.retarget.command.GaitCommand` takes;
+  (finite, above 0) [s], any optional field of its type, a ``command`` that
+  :class:`~imitwalk.retarget.command.GaitCommand` takes, ``params`` that
+  :class:`~imitwalk.retarget.params.GaitParams` takes (numbers), and ``settings`` whose
+  clip and robot entries are of their types;
 * the arrays in :data:`ARRAYS`, numbers, with the shapes the trajectories need:
   ``scales (S,)`` finite and increasing, ``loops (S, N, n)`` and ``starts (S, M, n)``
   finite [rad], ``strides (S,)``, ``start_travel (S, M)``, ``phase (N,)``,
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +31,7 @@ import numpy as np
 from imitwalk.errors import ConfigError, RunError
 from imitwalk.readback import check_fields, check_format, read_npz
 from imitwalk.retarget.command import LIMITS, GaitCommand
+from imitwalk.retarget.params import GaitParams
 
 __all__ = ["ARRAYS", "REFERENCE_FORMAT", "read_reference_file"]
 
@@ -45,6 +49,15 @@ _OPTIONAL = {
     **dict.fromkeys(("checks", "params", "search", "settings", "command", "scale_params"), dict),
 }
 _MOCAP = (".bvh", ".amc", ".asf", ".c3d")
+#: The types of a stored ``settings`` object's entries (each may be absent).
+_SETTINGS: dict[str, type | tuple[type, ...]] = {
+    "search": bool,
+    "motion_format": str,
+    "motion_fps": float,
+    "filled": list,
+    "robot": (str, type(None)),
+    "joint_map": (str, type(None)),
+}
 
 
 def read_reference_file(path: str | Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
@@ -66,6 +79,11 @@ def read_reference_file(path: str | Path) -> tuple[dict[str, Any], dict[str, np.
     if isinstance(meta, dict):
         check_format(meta, REFERENCE_FORMAT, f"{path} metadata", RunError)
     check_fields(meta, _META, f"{path} metadata", RunError, _OPTIONAL)
+    if meta.pop("scale_params", None):
+        raise RunError(
+            f"{path}: its parameters differ per stride (search_config.refine_per_scale, "
+            "removed in imitwalk 0.5); make it again with imitwalk retarget CLIP --out REF.npz"
+        )
     if not all(isinstance(j, str) for j in meta["joint_names"]):
         raise RunError(f"{path} metadata: joint_names are not all strings")
     for key in ("dt", "period"):
@@ -73,6 +91,8 @@ def read_reference_file(path: str | Path) -> tuple[dict[str, Any], dict[str, np.
             raise RunError(f"{path} metadata: {key} is {meta[key]}; expected a time above 0 s")
     meta["joint_names"] = tuple(meta["joint_names"])
     _check_command(meta.get("command") or {}, f"{path} metadata")
+    _check_params(meta.get("params") or {}, f"{path} metadata")
+    check_fields(meta.get("settings") or {}, {}, f"{path} metadata settings", RunError, _SETTINGS)
     _check_arrays(arrays, len(meta["joint_names"]), str(path))
     return meta, arrays
 
@@ -87,6 +107,25 @@ def _check_command(command: dict, where: str) -> None:
         GaitCommand.from_dict(command)
     except ConfigError as exc:
         raise RunError(f"{where}: its command is out of range: {exc}") from None
+
+
+def _check_params(params: dict, where: str) -> None:
+    """Refuse stored reference parameters that :class:`GaitParams` would not build."""
+    names = [f.name for f in fields(GaitParams)]
+    if unknown := sorted(set(params) - set(names)):
+        raise RunError(
+            f"{where}: unknown parameter(s) {', '.join(unknown)}; valid: {', '.join(names)}"
+        )
+    check_fields(
+        params,
+        {},
+        f"{where} params",
+        RunError,
+        {**dict.fromkeys(names, float), "lift": (float, type(None))},
+    )
+    for k, v in params.items():
+        if v is not None and not math.isfinite(v):
+            raise RunError(f"{where}: params {k} is {v}; expected a finite number")
 
 
 def _check_arrays(arrays: dict[str, np.ndarray], n: int, where: str) -> None:

@@ -20,6 +20,7 @@ Both use the robot's MuJoCo model for kinematics only (``mj_kinematics``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -27,6 +28,9 @@ import numpy as np
 from imitwalk.errors import MocapError
 from imitwalk.mocap.motion import LOWER_BODY, Motion
 from imitwalk.robots import Robot
+
+if TYPE_CHECKING:
+    from imitwalk.retarget.reference import Reference
 
 __all__ = ["BALL", "MotionModel", "RobotMotion", "clip_of_motion", "motion_of_reference"]
 
@@ -105,7 +109,7 @@ class MotionModel:
         self.sign = robot.signs.astype(float)
         self.soles = {s: m.site(robot.soles[s]).id for s in "lr"}
 
-    def qpos(self, root_pos, root_quat, joints) -> np.ndarray:
+    def qpos(self, root_pos: np.ndarray, root_quat: np.ndarray, joints: np.ndarray) -> np.ndarray:
         """``(..., nq)`` the model's ``qpos``: the base at ``root_pos`` ``(..., 3)`` and
         ``root_quat`` ``(..., 4)``, the roles at ``joints`` ``(..., n)`` (the robot's
         signs), the other joints as when standing."""
@@ -122,7 +126,7 @@ class MotionModel:
         r = self.robot
         return RobotMotion(r.name, fps, qpos[:, 0:3].copy(), quat, joints, r.joint_names, source)
 
-    def pose(self, root_pos, root_quat, joints) -> None:
+    def pose(self, root_pos: np.ndarray, root_quat: np.ndarray, joints: np.ndarray) -> None:
         """Pose the model at one frame (:meth:`qpos`)."""
         self.d.qpos[:] = self.qpos(root_pos, root_quat, joints)
         mujoco.mj_kinematics(self.m, self.d)
@@ -150,7 +154,7 @@ def _rz(yaw: float) -> np.ndarray:
 
 
 def motion_of_reference(
-    ref, robot: Robot, scale: float | None = None, cycles: int = 4
+    ref: Reference, robot: Robot, scale: float | None = None, cycles: int = 4
 ) -> RobotMotion:
     """The reference's walk from standing at ``scale`` (default: its largest): the
     start-up then ``cycles`` loops, each frame a control tick (``1 / ref.dt`` Hz), the

@@ -7,15 +7,17 @@ rollouts: each candidate reference is solved by IK at a few stride scales and pl
 on the nominal robot and on training perturbations (never an evaluation robot). A
 rollout scores ``alive fraction + ½·min(progress ratio, 1) − ½·min(|yaw drift| / 45°, 1)``.
 A ``walker`` plays each candidate under a controller instead (a learned balance law:
-:mod:`imitwalk.balance.refchoice`), with the same robots, scales and score.
+:mod:`imitwalk.learning.refchoice`), with the same robots, scales and score.
 """
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields, replace
 from functools import partial
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +27,7 @@ from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
 from imitwalk.retarget.params import leg_scaled
 from imitwalk.retarget.plan import GaitParams
+from imitwalk.retarget.searchreport import SearchReport
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.retarget.walkable import build_walkable
 from imitwalk.robots import Robot
@@ -32,6 +35,9 @@ from imitwalk.sim.metrics import WalkMetrics, walk_metrics
 from imitwalk.sim.mujoco import SimOptions, make_plant, playback
 from imitwalk.sim.perturb import perturbed, train_seeds
 from imitwalk.sim.types import ENGINES
+
+if TYPE_CHECKING:
+    from imitwalk.retarget.reference import Reference
 
 __all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "Walker", "bounds", "open_loop", "search_params"]
 
@@ -77,16 +83,6 @@ class SearchConfig:
         seconds: simulated time per rollout [s]; seed: the search's random seed.
         workers: parallel processes (``None``: one per core).
         engine: the physics engine of the trials (:data:`imitwalk.sim.types.ENGINES`).
-        refine_rounds: rounds of :func:`~imitwalk.retarget.refine.refine_params` after
-            the search (0: off); refine_scales: the stride scales it counts falls at;
-            refine_models, refine_seconds: its robots (the nominal one + training
-            perturbations, with the evaluation's initial push) and simulated
-            time per robot [s], at each of ``refine_scales``; refine_per_scale:
-            refine each of ``refine_scales`` on its own, judged there alone, and solve
-            the reference with each one's set at that scale
-            (:func:`~imitwalk.retarget.refine.refine_per_scale`; they must be grid scales);
-            refine_early_stop: stop a nudge's trial once it has fallen more often than the
-            set it must beat (the same nudges are kept; see :mod:`imitwalk.retarget.refine`).
     """
 
     generations: int = 5
@@ -98,14 +94,8 @@ class SearchConfig:
     seed: int = 0
     workers: int | None = None
     engine: str = "mujoco"
-    refine_rounds: int = 0
-    refine_scales: tuple[float, ...] = (0.8, 0.9, 1.0)
-    refine_models: int = 24
-    refine_seconds: float = 30.0
-    refine_per_scale: bool = False
-    refine_early_stop: bool = True
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.engine not in ENGINES:
             raise unknown_name("engine", self.engine, ENGINES, ConfigError)
         for name in ("generations", "population", "models"):
@@ -119,21 +109,13 @@ class SearchConfig:
             raise ConfigError(f"search_config.seconds: {self.seconds} is not above 0 s")
         if not self.scales or not all(0.0 < x <= 1.0 for x in self.scales):
             raise ConfigError(f"search_config.scales: {self.scales} must be scales in (0, 1]")
-        if self.refine_rounds < 0:
-            raise ConfigError(f"search_config.refine_rounds: {self.refine_rounds} is below 0")
-        if self.refine_rounds and (self.refine_models < 1 or self.refine_seconds <= 0):
-            raise ConfigError("search_config.refine_models must be >= 1 and refine_seconds > 0")
-        if self.refine_rounds and not all(0.0 < x <= 1.0 for x in self.refine_scales or [0]):
-            raise ConfigError(
-                f"search_config.refine_scales: {self.refine_scales} must be scales in (0, 1]"
-            )
 
 
 _IK: dict = {}
 
 
 def open_loop(
-    ref,
+    ref: Reference,
     robot: Robot,
     scale: float,
     seed: int,
@@ -150,7 +132,18 @@ def open_loop(
     )
 
 
-def _trial(job) -> dict:
+def _trial(
+    job: tuple[
+        GaitTemplate,
+        Robot,
+        GaitParams,
+        SearchConfig,
+        float,
+        SimOptions | None,
+        GaitCommand | None,
+        Walker | None,
+    ],
+) -> dict:
     template, robot, params, cfg, dt, base, command, walker = job
     key = (robot.name, str(robot.mjcf))
     ik = _IK.setdefault(key, WalkIK(robot))
@@ -188,17 +181,17 @@ def search_params(
     start: GaitParams | None = None,
     dt: float = 0.01,
     base: SimOptions | None = None,
-    progress=None,
+    progress: Callable[[int, int, float, dict], None] | None = None,
     command: GaitCommand | None = None,
     walker: Walker | None = None,
-) -> tuple[GaitParams, dict]:
+) -> tuple[GaitParams, SearchReport]:
     """Find reference parameters for ``template`` on ``robot`` (walking as ``command``
     says: a turn or sidestep is judged against its own path, a slope on its slope).
     ``walker`` (:data:`Walker`; ``None``: :func:`open_loop` on ``config.engine``) walks
     each candidate.
 
     Returns:
-        the best parameters found and a JSON-able report of every trial.
+        the best parameters found and the report of every trial.
     """
     cfg = config or SearchConfig()
     names = [f.name for f in fields(GaitParams)]
@@ -234,16 +227,16 @@ def search_params(
             progress(gen + 1, cfg.generations, best["score"], best["params"])
     assert best is not None  # at least one generation ran
     per = len(cfg.scales) * cfg.models * cfg.seconds
-    report = {
-        "method": "cross-entropy method over "
+    report = SearchReport(
+        method="cross-entropy method over "
         + ("open-loop rollouts" if walker is None else "rollouts under a learned law"),
-        "config": asdict(replace(cfg, workers=None)),
-        "bounds": box,
-        "score": "alive fraction + 0.5*min(progress,1) - 0.5*min(|yaw|/45deg,1), mean over runs",
-        "evaluations": len(history),
-        "sim_seconds": len(history) * per,
-        "wall_seconds": time.perf_counter() - t0,
-        "best": best,
-        "history": history,
-    }
+        config=json.loads(json.dumps(asdict(replace(cfg, workers=None)))),  # as a file holds it
+        bounds={k: list(v) for k, v in box.items()},
+        score="alive fraction + 0.5*min(progress,1) - 0.5*min(|yaw|/45deg,1), mean over runs",
+        evaluations=len(history),
+        sim_seconds=len(history) * per,
+        wall_seconds=time.perf_counter() - t0,
+        best=best,
+        history=tuple(history),
+    )
     return GaitParams(**best["params"]), report

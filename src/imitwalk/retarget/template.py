@@ -174,7 +174,14 @@ def extract_template(
     )
 
 
-def _one_cycle(kp, contacts, fwd_all, a: int, b: int, fps: float) -> dict:
+def _one_cycle(
+    kp: dict[str, np.ndarray],
+    contacts: dict[str, np.ndarray],
+    fwd_all: np.ndarray,
+    a: int,
+    b: int,
+    fps: float,
+) -> dict:
     """Per-cycle figures; ``[a, b)`` runs from a left heel strike to the next."""
     n = b - a
     fwd = fwd_all[a:b].mean(axis=0)

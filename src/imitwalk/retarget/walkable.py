@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imitwalk.errors import ConfigError
 from imitwalk.retarget.checks import kinematic_checks
 from imitwalk.retarget.command import GaitCommand
 from imitwalk.retarget.ik import WalkIK, leg_geometry
@@ -22,7 +21,7 @@ from imitwalk.retarget.reference import PLAN_KEYS, Reference, plan_arrays
 from imitwalk.retarget.template import GaitTemplate
 from imitwalk.robots import Robot
 
-__all__ = ["WalkableBuild", "build_walkable", "off_grid"]
+__all__ = ["WalkableBuild", "build_walkable"]
 
 
 @dataclass
@@ -34,12 +33,6 @@ class WalkableBuild:
     seconds: float
 
 
-def off_grid(grid, scales) -> list[float]:
-    """The ``scales`` that are not scales of ``grid`` (to within 1e-9)."""
-    g = np.asarray(grid, dtype=float)
-    return [float(s) for s in scales if not np.isclose(g, s, rtol=0.0, atol=1e-9).any()]
-
-
 def build_walkable(
     template: GaitTemplate,
     robot: Robot,
@@ -49,7 +42,6 @@ def build_walkable(
     ik: WalkIK | None = None,
     check_scale: float = 1.0,
     command: GaitCommand | None = None,
-    scale_params: dict[float, GaitParams] | None = None,
 ) -> WalkableBuild:
     """Solve the walkable reference at every scale.
 
@@ -60,17 +52,11 @@ def build_walkable(
         ik: a solver to reuse (built if ``None``).
         check_scale: the scale whose kinematics are checked (nearest in the grid).
         command: turn, sidestep, stride fraction and slope (default: straight, level).
-        scale_params: other parameters at some of ``scales`` (``{scale: params}``, e.g.
-            from :func:`~imitwalk.retarget.refine.refine_per_scale`); ``params`` elsewhere.
     """
     ik = ik or WalkIK(robot)
     geom = leg_geometry(robot)
     scales = np.asarray(sorted(scales), dtype=float)
     command = command or GaitCommand()
-    scale_params = scale_params or {}
-    if off := off_grid(scales, scale_params):
-        raise ConfigError(f"scale_params at {off}: not a grid scale of {scales.tolist()}")
-    own = {float(scales[np.abs(scales - s).argmin()]): p for s, p in scale_params.items()}
     starts, loops, strides, resid, clipped, travel, motion = [], [], [], [], [], [], []
     plans: dict[str, list] = {k: [] for k in PLAN_KEYS}
     t0 = time.perf_counter()
@@ -81,8 +67,9 @@ def build_walkable(
         # two start-up cycles and two steady ones: by the last cycle every foot has
         # landed by the steady rule, so that cycle is the closed loop and the rest,
         # which ends exactly where the loop begins, is the start-up
-        p = own.get(float(s), params)
-        plan = plan_walk(template, geom, p, float(s), dt, cycles=2, start=True, command=command)
+        plan = plan_walk(
+            template, geom, params, float(s), dt, cycles=2, start=True, command=command
+        )
         res = ik.solve(plan)
         assert plan.path is not None and plan.motion is not None  # plan_walk sets both
         frames += len(plan.phase)
@@ -130,10 +117,9 @@ def build_walkable(
         residual_mm=np.stack(resid),
         clipped=clipped,
         checks=checks,
-        params=params.to_dict(),
-        scale_params={f"{s:g}": p.to_dict() for s, p in sorted(own.items())},
+        params=params,
         plan={k: np.stack(v) for k, v in plans.items()},
-        command=command.to_dict(),
+        command=command,
         motion=np.stack(motion),
     )
     return WalkableBuild(ref, frames, elapsed)

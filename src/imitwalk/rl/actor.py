@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +23,7 @@ from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.rl.network import MLP
 from imitwalk.rl.observation import ObservationLayout, clock_phase
+from imitwalk.sim.types import Observation
 
 __all__ = ["ACTOR_FORMAT", "ActorSpec", "PolicyActor"]
 
@@ -119,7 +121,12 @@ class PolicyActor:
         mode).
     """
 
-    def __init__(self, spec: ActorSpec, net: MLP, base=None):
+    def __init__(
+        self,
+        spec: ActorSpec,
+        net: MLP,
+        base: Any = None,  # a step.controller.SteppingController (rl may not import step)
+    ):
         if (spec.layout.action == "residual") != (base is not None):
             raise RunError("a residual policy needs its stepping gait, a joints policy none")
         if net.sizes != (spec.layout.size, len(spec.q0)):
@@ -131,7 +138,7 @@ class PolicyActor:
         self.q0 = base.q0 if base is not None else spec.q0
         self.previous = spec.layout.action_center.copy()
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         s = self.spec
         if k == 0:
             self.previous = s.layout.action_center.copy()

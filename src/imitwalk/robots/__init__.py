@@ -7,7 +7,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from imitwalk.errors import RobotError, unknown_name
-from imitwalk.robots.jointmap import load_joint_map, parse_joint_map
+from imitwalk.robots.jointmap import JointMap, load_joint_map, parse_joint_map
 from imitwalk.robots.spec import ARM_ROLES, LEG_ROLES, ROLES, TRUNK_ROLES, Robot
 
 __all__ = [
@@ -81,6 +81,6 @@ def _named(jmap: Path, mjcf: Path | None, load: Callable[[], Robot]) -> Robot:
         raise type(exc)(f"{where}: {msg}") from None
 
 
-def _read(path: Path):
+def _read(path: Path) -> JointMap:
     """The joint map at ``path``, checked (:func:`parse_joint_map`)."""
     return parse_joint_map(load_joint_map(path), str(path))

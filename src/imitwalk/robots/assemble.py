@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -67,7 +68,13 @@ def _ctrlrange(model: mujoco.MjModel, j: int) -> tuple[float, float]:
     return -math.pi, math.pi
 
 
-def _servos(jm: JointMap, model, roles, joints, tree: Tree) -> tuple[ServoGains, ...]:
+def _servos(
+    jm: JointMap,
+    model: mujoco.MjModel,
+    roles: tuple[str, ...],
+    joints: tuple[str, ...],
+    tree: Tree,
+) -> tuple[ServoGains, ...]:
     """Servos for role joints with a motor or no actuator, or named in ``servos``; and for
     other hinges with a motor (held at the standing posture)."""
     acts = _actuators(model)
@@ -105,7 +112,14 @@ def _servos(jm: JointMap, model, roles, joints, tree: Tree) -> tuple[ServoGains,
     return tuple(out)
 
 
-def _sole_pads(model, data, tree, side, sole, names) -> TouchPads:
+def _sole_pads(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    tree: Tree,
+    side: str,
+    sole: str | SoleSpec,
+    names: tuple[str, str, str, str],
+) -> TouchPads:
     """Touch pads under the sole ``sole`` (a SoleSpec, a site or a body name)."""
     if isinstance(sole, SoleSpec):
         return TouchPads(sole.body, sole.pos, sole.quat, sole.size, names)
@@ -117,7 +131,7 @@ def _sole_pads(model, data, tree, side, sole, names) -> TouchPads:
     return TouchPads(model.body(body).name, pos, quat, (float(hx), float(hy)), names)
 
 
-def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf) -> tuple[Additions, Resolved]:
+def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf: Path) -> tuple[Additions, Resolved]:
     """Check ``jm``'s names against ``model`` (the user's file compiled as it is) and
     list what building the robot adds.
 
@@ -199,7 +213,8 @@ def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf) -> tuple[Additions
             names = tuple(free_name(used, f"{side}_fsr_{q}") for q in FSR_LAYOUT)
             used |= set(names)
             foot_force[side] = names
-            pads.append(_sole_pads(model, tree.data, tree, side, jm.soles[side], names))
+            # one name per entry of FSR_LAYOUT (4), which mypy cannot see through tuple()
+            pads.append(_sole_pads(model, tree.data, tree, side, jm.soles[side], names))  # type: ignore[arg-type]
     floor = not any(
         model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE and model.geom_bodyid[g] == 0
         for g in range(model.ngeom)

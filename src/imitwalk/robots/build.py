@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Container
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -134,7 +135,7 @@ def _compile_spec(spec: mujoco.MjSpec, mjcf: Path) -> mujoco.MjModel:
     return model
 
 
-def free_name(taken, wanted: str) -> str:
+def free_name(taken: Container[str | None], wanted: str) -> str:
     """``wanted``, or ``imitwalk_<wanted>`` (repeated) if ``taken`` has it."""
     while wanted in taken:
         wanted = f"imitwalk_{wanted}"

@@ -4,13 +4,12 @@
 the kinematic tree (:mod:`imitwalk.robots.roles`), the soles from the feet's collision
 geoms, the sensors the file already has on the torso and the feet, and the standing
 posture: the file's keyframe if it has one, else a solved one (:mod:`imitwalk.robots.posture`).
-It then builds the robot from the draft and holds that posture for
-:data:`imitwalk.sim.standing.CHECK_SECONDS`, judged by the stand check of
-:mod:`imitwalk.sim.standing` (the one ``robot stand`` and ``learn`` use). A robot that does
-not stand is still drafted: the joint map is what the user edits to make it stand (its
-``servos``, ``stand_keyframe``/``stand``, ``soles``), so :attr:`Draft.stand` says so and
-:meth:`Draft.advice` says what to change, and ``robot import`` writes the map and warns.
-Each guess, and each thing it could not guess, is one line of :attr:`Draft.lines`.
+It then builds the robot from the draft. Drafting simulates nothing: ``robot import``
+holds the drafted posture for :data:`imitwalk.sim.standing.CHECK_SECONDS` with the stand
+check of :mod:`imitwalk.sim.standing` (the one ``robot stand`` and ``learn`` use). A robot
+that does not stand is still drafted: the joint map is what the user edits to make it
+stand (its ``servos``, ``stand_keyframe``/``stand``, ``soles``). Each guess, and each thing
+it could not guess, is one line of :attr:`Draft.lines`.
 """
 
 from __future__ import annotations
@@ -18,7 +17,6 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -31,9 +29,6 @@ from imitwalk.robots.servos import actuator_kind
 from imitwalk.robots.spec import LEG_ROLES, ROLES, Robot
 from imitwalk.robots.tree import Tree, footprint
 
-if TYPE_CHECKING:  # imitwalk.sim imports imitwalk.robots
-    from imitwalk.sim.standing import StandResult
-
 __all__ = ["Draft", "draft_joint_map"]
 
 _KEY_HINTS = ("stand", "home", "default", "init")
@@ -42,18 +37,11 @@ _KEY_HINTS = ("stand", "home", "default", "init")
 @dataclass(frozen=True)
 class Draft:
     """A drafted joint map: ``jmap`` (the JSON object), ``lines`` (one per guess and per
-    thing not guessed), ``robot`` (built from it) and its stand check ``stand`` (whose
-    ``stands`` may be false: the map is drafted all the same)."""
+    thing not guessed) and ``robot`` (built from it)."""
 
     jmap: dict
     lines: tuple[str, ...]
     robot: Robot
-    stand: StandResult
-
-    def advice(self, where: str) -> str | None:
-        """``None`` if the drafted robot stands, else one line saying it does not and what
-        to change in the joint map written at ``where``."""
-        return None if self.stand.stands else self.stand.refusal(where)
 
 
 def _sole(tree: Tree, body: int, bodies: list[int]) -> dict | str:
@@ -135,15 +123,11 @@ def draft_joint_map(mjcf: str | Path, out: str | Path) -> Draft:
     """Draft the joint map of ``mjcf``, to be written at ``out`` (its ``mjcf`` entry is
     relative to ``out``'s folder).
 
-    A robot that does not stand in the drafted posture is not refused (see the module
-    docstring): :attr:`Draft.stand` ``.stands`` is false.
-
     Raises:
         RobotError: no floating base; no legs (the bodies seen are listed); a leg role
             that cannot be guessed.
     """
     from imitwalk.robots.posture import solve_stand
-    from imitwalk.sim.standing import CHECK_SECONDS, stand_test
 
     mjcf, out = Path(mjcf), Path(out)
     model = compile_model(mjcf)
@@ -191,10 +175,4 @@ def draft_joint_map(mjcf: str | Path, out: str | Path) -> Draft:
         jmap["stand"] = solve_stand(robot, arms)
         robot = Robot.from_map(parse_joint_map(jmap, str(out)), out.parent, mjcf=mjcf)
         lines.append("solved standing posture: knees bent, feet flat, centre of mass over them")
-    res = stand_test(robot, seconds=CHECK_SECONDS)
-    verdict = "stands" if res.stands else "does NOT stand"
-    lines.append(
-        f"{verdict} {CHECK_SECONDS:g} s: tilt up to {res.max_tilt_deg:.1f} deg "
-        f"(limit {res.tilt_limit_deg:g}), height lost {res.height_lost_m * 1000:.1f} mm"
-    )
-    return Draft(jmap, tuple(lines), robot, res)
+    return Draft(jmap, tuple(lines), robot)

@@ -35,7 +35,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Final, Required, TypedDict
+from typing import Final, NoReturn, Required, TypedDict
 
 from imitwalk.errors import RobotError, unknown_name
 from imitwalk.robots.rolenames import LEG_ROLES, ROLES
@@ -137,7 +137,7 @@ def load_joint_map(path: str | Path) -> dict:
     return data
 
 
-def _no_constant(name: str):
+def _no_constant(name: str) -> NoReturn:
     raise ValueError(f"{name} is not a number JSON allows")
 
 
@@ -145,13 +145,13 @@ def _where(source: str, key: str) -> str:
     return f"joint map {source}: {key!r}"
 
 
-def _string(value, source: str, key: str) -> str:
+def _string(value: object, source: str, key: str) -> str:
     if not isinstance(value, str) or not value:
         raise RobotError(f"{_where(source, key)} must be a non-empty string, got {_kind(value)}")
     return value
 
 
-def _number(value, source: str, key: str, positive: bool = False) -> float:
+def _number(value: object, source: str, key: str, positive: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise RobotError(f"{_where(source, key)} must be a number, got {_kind(value)}")
     try:
@@ -164,13 +164,13 @@ def _number(value, source: str, key: str, positive: bool = False) -> float:
     return x
 
 
-def _object(value, source: str, key: str, what: str) -> dict:
+def _object(value: object, source: str, key: str, what: str) -> dict:
     if not isinstance(value, dict):
         raise RobotError(f"{_where(source, key)} must be an object of {what}, got {_kind(value)}")
     return value
 
 
-def _kind(value) -> str:
+def _kind(value: object) -> str:
     if value is None:
         return "null"
     if isinstance(value, bool):
@@ -182,7 +182,7 @@ def _kind(value) -> str:
     return _KINDS.get(type(value), type(value).__name__)
 
 
-def _joint(role: str, entry, source: str) -> tuple[str, float]:
+def _joint(role: str, entry: object, source: str) -> tuple[str, float]:
     key = f"joints.{role}"
     if isinstance(entry, str):
         return _string(entry, source, key), 1.0
@@ -197,7 +197,7 @@ def _joint(role: str, entry, source: str) -> tuple[str, float]:
     return name, float(sign)
 
 
-def _sole(side: str, entry, source: str) -> str | SoleSpec:
+def _sole(side: str, entry: object, source: str) -> str | SoleSpec:
     key = f"soles.{side}"
     if isinstance(entry, str):
         return _string(entry, source, key)

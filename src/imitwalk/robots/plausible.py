@@ -58,7 +58,7 @@ JOINT_RANGE_RAD: tuple[float, float] = (-2 * math.pi, 2 * math.pi)
 SERVO_KP: tuple[float, float] = (0.0, 1e5)
 
 
-def _within(where: str, what: str, value: float, bounds: tuple[float, float], unit: str):
+def _within(where: str, what: str, value: float, bounds: tuple[float, float], unit: str) -> None:
     """Refuse ``value`` [``unit``] outside ``bounds`` (inclusive), in one line."""
     lo, hi = bounds
     if not lo <= value <= hi:

@@ -86,7 +86,15 @@ def _hint(name: str) -> str | None:
     return hits.pop() if len(hits) == 1 else None
 
 
-def _pick(tree, sk, joints, kind, role, where, used) -> int | None:
+def _pick(
+    tree: Tree,
+    sk: Skeleton,
+    joints: list[int],
+    kind: str,
+    role: str,
+    where: str,
+    used: set[int],
+) -> int | None:
     """The best-aligned hinge of ``kind`` among ``joints``; a guess for ``role``."""
     cands = [j for j in joints if tree.axis(j)[0] == kind and j not in used]
     if not cands:

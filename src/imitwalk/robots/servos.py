@@ -69,7 +69,9 @@ def torque_limit(model: mujoco.MjModel, a: int | None, joint: int) -> float:
     return out
 
 
-def default_gains(leg: bool, mass: float, leg_length: float, gravity: float = 9.81):
+def default_gains(
+    leg: bool, mass: float, leg_length: float, gravity: float = 9.81
+) -> tuple[float, float, float]:
     """``(kp [Nm/rad], kv [Nm s/rad], torque limit [Nm])`` of a servo for a robot of
     ``mass`` [kg] and ``leg_length`` [m]; ``leg``: a leg joint (else a quarter of it)."""
     mgl = mass * gravity * leg_length

@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 
 from imitwalk.errors import RobotError, unknown_name
-from imitwalk.robots.assemble import plan_additions
+from imitwalk.robots.assemble import Resolved, plan_additions
 from imitwalk.robots.build import Additions, compile_model
 from imitwalk.robots.jointmap import JointMap, load_joint_map, parse_joint_map
 from imitwalk.robots.plausible import check_masses, check_standing
@@ -129,7 +129,9 @@ class Robot:
         return _build(cls, jm, res, mjcf, model, add)
 
 
-def _build(cls, jm: JointMap, res, mjcf: Path, model: mujoco.MjModel, add: Additions) -> Robot:
+def _build(
+    cls: type[Robot], jm: JointMap, res: Resolved, mjcf: Path, model: mujoco.MjModel, add: Additions
+) -> Robot:
     roles, mj_joints, signs = res.roles, res.joints, np.array(res.signs)
     root = int(model.body_rootid[model.body(res.torso).id])
     check_masses(model, mjcf, float(model.body_subtreemass[root]))

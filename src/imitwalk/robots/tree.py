@@ -8,6 +8,7 @@ geoms. The world frame is the file's: z up; the robot faces +x with its left alo
 
 from __future__ import annotations
 
+from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 
 import mujoco
@@ -49,7 +50,9 @@ def _box(model: mujoco.MjModel, data: mujoco.MjData, g: int) -> tuple[np.ndarray
     return centre, np.abs(rot) @ model.geom_aabb[g, 3:]
 
 
-def footprint(model: mujoco.MjModel, data: mujoco.MjData, bodies, near: float = 0.01) -> Footprint:
+def footprint(
+    model: mujoco.MjModel, data: mujoco.MjData, bodies: Collection[int], near: float = 0.01
+) -> Footprint:
     """The footprint of the colliding geoms of ``bodies`` whose bottom is within ``near``
     [m] of the lowest one (the sole, not the ankle bracket above it)."""
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in set(bodies)]
@@ -116,7 +119,7 @@ class Tree:
             raise RobotError(f"body {self.name(out[-1])!r} is not below {self.name(top)!r}")
         return out[::-1]
 
-    def hinges(self, bodies) -> list[int]:
+    def hinges(self, bodies: Iterable[int]) -> list[int]:
         """Hinge joint ids of ``bodies``, in order."""
         m = self.model
         return [

@@ -13,6 +13,7 @@ a joint are fixed to their parent; the free-floating root is the URDF's base lin
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -60,7 +61,7 @@ class UrdfRobot:
     meshes: dict[str, str] = field(default_factory=dict)
 
 
-def _v(x) -> str:
+def _v(x: Iterable[float]) -> str:
     return " ".join(f"{float(a):.9g}" for a in x)
 
 
@@ -99,7 +100,7 @@ def _geom(m: mujoco.MjModel, g: int, shift: np.ndarray, meshes: dict | None) -> 
     return f"<collision>{origin}<geometry>{shape}</geometry></collision>"
 
 
-def to_urdf(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> UrdfRobot:
+def to_urdf(robot: Robot, com_shift: Sequence[float] = (0.0, 0.0, 0.0)) -> UrdfRobot:
     """Write ``robot``'s compiled MuJoCo model as URDF, with the torso's centre of mass
     moved by ``com_shift`` ``(3,)`` [m] in its own frame (as ``SimOptions.com_shift``).
 
@@ -194,7 +195,7 @@ def _obj(m: mujoco.MjModel, mid: int) -> str:
 _FILES: dict[tuple, tuple[Path, UrdfRobot]] = {}
 
 
-def urdf_file(robot: Robot, com_shift=(0.0, 0.0, 0.0)) -> tuple[Path, UrdfRobot]:
+def urdf_file(robot: Robot, com_shift: Sequence[float] = (0.0, 0.0, 0.0)) -> tuple[Path, UrdfRobot]:
     """``robot`` as URDF (see :func:`to_urdf`), written once per process to a temporary
     folder."""
     shift = tuple(float(x) for x in com_shift)

@@ -96,7 +96,7 @@ def check_model(model: mujoco.MjModel, mjcf: Path) -> None:
         raise RobotError(f"{mjcf.name}: the model has no mass")
 
 
-def _name(model: mujoco.MjModel, objtype, i: int) -> str:
+def _name(model: mujoco.MjModel, objtype: mujoco.mjtObj, i: int) -> str:
     try:
         return mujoco.mj_id2name(model, objtype, i) or ""
     except UnicodeDecodeError:

@@ -22,17 +22,24 @@ steps physics or renders), no SciPy, Bullet, mink or matplotlib.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from imitwalk.errors import SensorError
 from imitwalk.runtime.bundle import Bundle, read_bundle
 from imitwalk.runtime.sensors import SensorLayout
 
+if TYPE_CHECKING:
+    from imitwalk.rl.actor import PolicyActor
+    from imitwalk.sim.types import Observation
+    from imitwalk.step.controller import SteppingController
+
 __all__ = ["Controller"]
 
 
-def _policy(b: Bundle):
+def _policy(b: Bundle) -> SteppingController | PolicyActor:
     """The controller object ``b`` describes: a policy ``(tick, observation) -> (n,)``."""
     from imitwalk.step.controller import SteppingController
 
@@ -80,7 +87,7 @@ class Controller:
         """
         return cls(read_bundle(folder))
 
-    def reset(self, sensors) -> np.ndarray:
+    def reset(self, sensors: npt.ArrayLike) -> np.ndarray:
         """Start a walk from the robot standing: its readings now ``(6 + 2k + n,)``. Returns
         the joint targets of this first tick ``(n,)`` [rad].
 
@@ -90,7 +97,7 @@ class Controller:
         self._tick = 0
         return self._decide(sensors)
 
-    def step(self, sensors) -> np.ndarray:
+    def step(self, sensors: npt.ArrayLike) -> np.ndarray:
         """One control tick: the readings now ``(6 + 2k + n,)`` → joint targets ``(n,)``
         [rad], to be sent to the position servos until the next tick.
 
@@ -103,7 +110,7 @@ class Controller:
         self._tick += 1
         return self._decide(sensors)
 
-    def _decide(self, sensors) -> np.ndarray:
+    def _decide(self, sensors: npt.ArrayLike) -> np.ndarray:
         assert self._tick is not None
         obs = self.sensors.observation(sensors, self._tick * self.dt)
         return np.asarray(self._policy(self._tick, obs), dtype=float)
@@ -121,6 +128,6 @@ class _AsPolicy:
     def __init__(self, ctl: Controller):
         self.ctl, self.q0 = ctl, ctl.q0
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         v = self.ctl.sensors.vector(obs)
         return self.ctl.reset(v) if k == 0 else self.ctl.step(v)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+import numpy.typing as npt
 
 from imitwalk.errors import SensorError
 from imitwalk.sim.types import Observation
@@ -70,7 +71,7 @@ class SensorLayout:
         """Each block's slice of the vector (computed once: a controller asks every tick)."""
         return dict(self._slices)
 
-    def observation(self, sensors, t: float = 0.0) -> Observation:
+    def observation(self, sensors: npt.ArrayLike, t: float = 0.0) -> Observation:
         """The readings ``sensors`` ``(6 + 2k + n,)`` as an observation at time ``t`` [s].
 
         Raises:

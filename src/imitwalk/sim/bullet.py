@@ -20,6 +20,7 @@ perturbations of :class:`~imitwalk.sim.types.SimOptions` use the same random dra
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Sequence
 
 import numpy as np
 import pybullet as pb
@@ -41,7 +42,7 @@ from imitwalk.sim.types import (
 __all__ = ["BulletPlant"]
 
 
-def _rot(quat_xyzw) -> np.ndarray:
+def _rot(quat_xyzw: Sequence[float]) -> np.ndarray:
     return np.array(pb.getMatrixFromQuaternion(quat_xyzw)).reshape(3, 3)
 
 
@@ -111,7 +112,7 @@ class BulletPlant:
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
-        def site(name: str, sensor: bool = True):
+        def site(name: str, sensor: bool = True) -> tuple[int, np.ndarray, np.ndarray]:
             """(link, position in it, half-size) of a sensor's site, or of a sole (a site,
             else a body's origin)."""
             if not sensor and name not in [m.site(i).name for i in range(m.nsite)]:
@@ -135,7 +136,7 @@ class BulletPlant:
         self.fell = False
         self.fall_time: float | None = None
 
-    def __del__(self):
+    def __del__(self) -> None:
         with contextlib.suppress(Exception):  # already gone at interpreter exit
             pb.disconnect(self.client)
 
@@ -154,7 +155,7 @@ class BulletPlant:
             pos, orn = st[4], st[5]
         return np.array(pos), _rot(orn), orn
 
-    def _place_base(self, pos, orn) -> None:
+    def _place_base(self, pos: Sequence[float], orn: Sequence[float]) -> None:
         """Put the base link's URDF frame (not its centre of mass) at ``pos``, ``orn``."""
         ipos, iorn = pb.getDynamicsInfo(self.body, -1, physicsClientId=self.client)[3:5]
         pos, orn = pb.multiplyTransforms(pos, orn, ipos, iorn)

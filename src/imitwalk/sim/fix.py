@@ -11,6 +11,7 @@ the noisy reading.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +48,7 @@ class FixSensor:
         self._origin: np.ndarray | None = None
         self._next = 1.0 / fix.rate_hz
 
-    def read(self, plant, t: float) -> np.ndarray | None:
+    def read(self, plant: Any, t: float) -> np.ndarray | None:
         """``(2,)`` the fix [m] in the start frame if one is due at time ``t`` [s], else
         ``None``. The first call (at the start) sets the frame."""
         pos, quat = plant.torso_pose()

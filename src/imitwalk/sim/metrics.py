@@ -8,8 +8,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from imitwalk.sim.types import Rollout
 
 __all__ = [
     "GaitTiming",
@@ -89,7 +93,7 @@ class WalkMetrics:
 
 
 def walk_metrics(
-    rollout,
+    rollout: Rollout,
     expected_distance: float,
     q_ref: np.ndarray | None = None,
     track: np.ndarray | None = None,
@@ -169,7 +173,7 @@ def _share(beyond: float, now: float, whole: float) -> float:
 SATURATED = 0.99
 
 
-def _saturation(rollout) -> tuple[float | None, str | None]:
+def _saturation(rollout: Rollout) -> tuple[float | None, str | None]:
     """The most saturated joint's fraction of saturated ticks, and its name."""
     tau, limit = getattr(rollout, "torque", None), getattr(rollout, "torque_limit", None)
     if tau is None or limit is None or len(tau) == 0:
@@ -224,7 +228,11 @@ class GaitTiming:
 
 
 def gait_timing(
-    rollout, weight_n: float, after_s: float = 0.0, load: float = 0.1, lifted_s: float = 0.08
+    rollout: Rollout,
+    weight_n: float,
+    after_s: float = 0.0,
+    load: float = 0.1,
+    lifted_s: float = 0.08,
 ) -> GaitTiming:
     """The touchdowns of a rollout: a sole takes more than ``load`` of ``weight_n`` [N]
     after it carried almost nothing (under a quarter of that) for at least ``lifted_s``

@@ -212,7 +212,9 @@ class MujocoPlant:
             self.fell, self.fall_time = True, float(d.time)
 
 
-def make_plant(robot: Robot, options: SimOptions | None = None, engine: str = "mujoco"):
+def make_plant(
+    robot: Robot, options: SimOptions | None = None, engine: str = "mujoco"
+) -> MujocoPlant | BulletPlant:
     """A plant of ``robot`` on ``engine`` (one of :data:`ENGINES`).
 
     Raises:

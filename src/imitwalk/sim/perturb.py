@@ -5,9 +5,10 @@ Seed 0 is the nominal robot. Every other seed draws a perturbed one: each body's
 evaluation of a learned gait) a small initial disturbance of the base velocity. Each
 of these *factors* (:data:`FACTORS`) can be left out; the others keep their draws, so
 a robot with one factor left out differs from the full one in that factor only.
-Evaluation seeds are 0-99; learning and the reference search only use seeds from
-:data:`TRAIN_SEED_BASE` up, so they never see an evaluation robot; the learner's trials
-of its channel gain use seeds from :data:`TRIAL_SEED_BASE` up, robots it never learned on.
+Which seeds are which robots is :mod:`imitwalk.sim.seeds`'s registry: learning and the
+reference search only use seeds above :data:`~imitwalk.sim.seeds.TRAIN_SEED_BASE`, so they
+never see an evaluation robot; the learner's gain trials use seeds above
+:data:`~imitwalk.sim.seeds.TRIAL_SEED_BASE`, robots it never learned on.
 """
 
 from __future__ import annotations
@@ -17,13 +18,12 @@ from dataclasses import replace
 import numpy as np
 
 from imitwalk.errors import ConfigError, unknown_name
+from imitwalk.sim.seeds import DRAW_STREAM, TRAIN_SEED_BASE, TRIAL_SEED_BASE
 from imitwalk.sim.types import SimOptions
 
 __all__ = [
     "FACTORS",
     "FRICTION_RANGE",
-    "TRAIN_SEED_BASE",
-    "TRIAL_SEED_BASE",
     "perturbed",
     "train_seeds",
     "trial_seeds",
@@ -36,12 +36,6 @@ FACTORS = ("mass", "friction", "servo", "disturbance")
 #: The range a perturbed robot's floor friction is drawn from (evaluation's, and by default
 #: the learner's ``train_friction``).
 FRICTION_RANGE = (0.7, 1.0)
-
-#: Seeds at or above this are reserved for learning and searching.
-TRAIN_SEED_BASE = 1000
-#: Seeds at or above this are the gain trials' (:mod:`imitwalk.trust`); learning's draws
-#: stay below it (they would need ~10⁵ training robots to reach it).
-TRIAL_SEED_BASE = 100_000
 
 
 def perturbed(
@@ -69,7 +63,7 @@ def perturbed(
     base = base or SimOptions()
     if seed == 0:
         return replace(base, seed=0)
-    rng = np.random.default_rng([seed, 20070106])
+    rng = np.random.default_rng([seed, DRAW_STREAM])
     twist = (0.0,) * 6
     if disturbance:
         twist = tuple(np.concatenate([rng.normal(0, 0.02, 3), rng.normal(0, 0.1, 3)]).tolist())

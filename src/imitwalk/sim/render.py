@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -108,7 +109,7 @@ class Renderer:
 
 
 def render_frames(
-    robot: Robot, qpos: np.ndarray, dt: float, fps: float = 30.0, **kw
+    robot: Robot, qpos: np.ndarray, dt: float, fps: float = 30.0, **kw: Any
 ) -> list[np.ndarray]:
     """Render ``(N, nq)`` states sampled every ``dt`` [s] at ``fps`` frames per second."""
     if len(qpos) == 0:

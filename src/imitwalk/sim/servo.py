@@ -44,7 +44,9 @@ class StablePD:
         n = len(self.kp)
         self.tau, self._qd, self._other = np.zeros(n), np.zeros(n), np.zeros(n)
 
-    def torque(self, target, q, qd, mjj) -> np.ndarray:
+    def torque(
+        self, target: np.ndarray, q: np.ndarray, qd: np.ndarray, mjj: np.ndarray
+    ) -> np.ndarray:
         """``(n,)`` torques [Nm] for this physics step, clipped to the limits.
 
         Args:

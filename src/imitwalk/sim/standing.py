@@ -109,6 +109,14 @@ class StandResult:
             )
         return "; ".join(out) or f"torso tilted {self.max_tilt_deg:.1f} deg"
 
+    def line(self) -> str:
+        """One line: whether it stood, its largest tilt and the height it lost."""
+        verdict = "stands" if self.stands else "does NOT stand"
+        return (
+            f"{verdict} {self.seconds:g} s: tilt up to {self.max_tilt_deg:.1f} deg "
+            f"(limit {self.tilt_limit_deg:g}), height lost {self.height_lost_m * 1000:.1f} mm"
+        )
+
     def refusal(self, robot: str) -> str:
         """One line saying that ``robot`` cannot stand, what was measured and what to change,
         by the joint map's keys."""

@@ -49,7 +49,7 @@ class SimOptions:
         pushes: velocity kicks ``(t [s], Δv_x, Δv_y [m/s])``, in time order: at the first
             physics step at or after ``t`` the whole robot's horizontal velocity changes by
             ``Δv`` (world frame), an impulse of mass × Δv, so a kick means the same on a
-            light and a heavy robot (:mod:`imitwalk.judge.protocol` draws them).
+            light and a heavy robot (:mod:`imitwalk.sim.protocol` draws them).
         init_twist: ``(6,)`` initial base velocity, linear [m/s] then angular [rad/s].
         seed: seeds sensor noise and jitter.
         fall_height: a fall is the torso under this fraction of its standing height ...
@@ -108,7 +108,9 @@ class ServoQueue:
         return self._now
 
 
-def kicks_due(pushes, t: float, done: int) -> tuple[int, np.ndarray]:
+def kicks_due(
+    pushes: tuple[tuple[float, float, float], ...], t: float, done: int
+) -> tuple[int, np.ndarray]:
     """The velocity kicks of ``pushes`` due by time ``t`` [s] that were not applied yet
     (``done`` of them were): how many are done now, and their summed ``(2,)`` Δv [m/s]."""
     dv = np.zeros(2)
@@ -129,7 +131,7 @@ def gravity(opt: SimOptions) -> np.ndarray:
     return -9.81 * normal / np.linalg.norm(normal)
 
 
-def checked_targets(targets, n: int) -> np.ndarray:
+def checked_targets(targets: np.ndarray, n: int) -> np.ndarray:
     """``targets`` as a ``(n,)`` float array of joint targets [rad].
 
     Raises:

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.robots import Robot
+from imitwalk.sim.types import Observation
 from imitwalk.step.estimator import BodyEstimate, BodyEstimator, ObserverNoise
 from imitwalk.step.gains import StepGains
 from imitwalk.step.joints import JointSolver
@@ -130,7 +131,7 @@ class SteppingController:
         return self.odometry.pose(self._com, self._heading)
 
     # -- the tick ------------------------------------------------------------------
-    def _start(self, obs) -> None:
+    def _start(self, obs: Observation) -> None:
         st, g = self.style, self.gains
         noise = ObserverNoise(accel=10.0**g.observer)
         self.est = BodyEstimator(self.fk, self.dt, self.omega, noise)
@@ -183,7 +184,7 @@ class SteppingController:
             max(self.ds_time - self.t_phase, 0.0),
         )
 
-    def __call__(self, k: int, obs) -> np.ndarray:
+    def __call__(self, k: int, obs: Observation) -> np.ndarray:
         if k == 0 or not self._started:
             self._start(obs)
         dt, g = self.dt, self.gains

@@ -7,16 +7,20 @@ The learner (:mod:`imitwalk.step.learn`) and the judge walk many of these in par
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.metrics import WalkMetrics
-from imitwalk.sim.types import SimOptions
+from imitwalk.sim.types import Rollout, SimOptions
 from imitwalk.step.gains import StepGains
 from imitwalk.step.schedule import nominal_track
 from imitwalk.step.style import GaitStyle
+
+if TYPE_CHECKING:  # the controller poses the robot with MuJoCo: imported where it walks
+    from imitwalk.step.controller import SteppingController
 
 __all__ = ["FALL_COST", "StepJob", "StepScore", "score_walk", "walk_step"]
 
@@ -79,7 +83,7 @@ def score_walk(m: WalkMetrics, seconds: float) -> float:
     return 0.5 * FALL_COST * (0.9 * short + 0.9 * drift)
 
 
-def walk_step(job: StepJob, log: bool = False):
+def walk_step(job: StepJob, log: bool = False) -> tuple[SteppingController, Rollout, WalkMetrics]:
     """Walk ``job``: its controller, rollout and :class:`~imitwalk.sim.metrics.WalkMetrics`
     (a walk its map no longer needs ends early, see :func:`~imitwalk.parallel.abandoned`)."""
     from imitwalk.sim.metrics import walk_metrics

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imitwalk.balance.estimator import StateEstimator
+from imitwalk.sim.types import Observation
 from imitwalk.step.kinematics import BodyModel, FootPose, rot_xyz, rot_z
 from imitwalk.step.lipm import GRAVITY
 
@@ -130,7 +131,7 @@ class BodyEstimator:
         self._slope = np.zeros(2)  # the floor's dz/dx, dz/dy under the stance sole
         self._frame: tuple[np.ndarray, float] | None = None
 
-    def _pose(self, obs) -> tuple[np.ndarray, np.ndarray, float]:
+    def _pose(self, obs: Observation) -> tuple[np.ndarray, np.ndarray, float]:
         """Pose the model on the encoders, the pelvis turned by the attitude; the
         rotation from the pelvis frame to the stance frame, the stance sole's position
         in the pelvis frame, and its heading in the start frame."""
@@ -150,7 +151,7 @@ class BodyEstimator:
         self._slope += min(self.dt / SLOPE_TAU, 1.0) * (slope - self._slope)
         return to_stance, b.sole_pos(st), heading
 
-    def update(self, obs, zmp_hint: np.ndarray) -> BodyEstimate:
+    def update(self, obs: Observation, zmp_hint: np.ndarray) -> BodyEstimate:
         """Fold in one tick's readings; ``zmp_hint`` ``(2,)`` [m] drives the observer
         when no sole touches the ground."""
         rot, origin, heading = self._pose(obs)

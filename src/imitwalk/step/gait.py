@@ -19,6 +19,7 @@ import numpy as np
 from imitwalk import readback
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write
+from imitwalk.retarget.provenance import Provenance
 from imitwalk.sim.types import SimOptions
 from imitwalk.step.schedule import START_STEPS, nominal_distance, nominal_track, start_seconds
 from imitwalk.step.style import GaitStyle
@@ -37,8 +38,8 @@ class StepGait:
     Attributes:
         style: the walk at scale 1 (:class:`~imitwalk.step.style.GaitStyle`); robot: the
         robot's name; dt: the control period [s]; source: the clip; cycles: ``(C, 2)``
-        the clip's frames of the cycles averaged; settings: where the robot came from
-        (``robot``: a built-in name or a joint map's path, ``joint_map``).
+        the clip's frames of the cycles averaged; provenance: the clip as it was read and
+        the robot as it was named (a built-in name or a joint map's path).
     """
 
     style: GaitStyle
@@ -46,7 +47,7 @@ class StepGait:
     dt: float = 0.01
     source: str = ""
     cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
-    settings: dict = field(default_factory=dict)
+    provenance: Provenance = field(default_factory=Provenance)
 
     @property
     def period(self) -> float:
@@ -114,7 +115,7 @@ class StepGait:
             "dt": self.dt,
             "source": self.source,
             "cycles": np.asarray(self.cycles, dtype=int).tolist(),
-            "settings": self.settings,
+            "settings": self.provenance.to_settings(),
         }
 
     def save(self, path: str | Path) -> Path:
@@ -137,7 +138,7 @@ class StepGait:
                 dt=float(d["dt"]),
                 source=str(d.get("source", "")),
                 cycles=np.asarray(d.get("cycles", []), dtype=int).reshape(-1, 2),
-                settings=dict(d.get("settings", {})),
+                provenance=Provenance.from_settings(dict(d.get("settings") or {})),
             )
         except FileNotFoundError:
             raise RunError(f"{path} not found: is {path.parent} a finished imitwalk run?") from None

@@ -7,7 +7,7 @@ their ranges, starting from the shipped gains (:class:`~imitwalk.step.gains.Step
 defaults). Each generation
 walks every candidate on the same few training robots, drawn from a protocol (``hard``
 by default: friction, mass, servos, a shifted torso, noisy sensors, late servos,
-slopes and kicks) at seeds that no judge uses (from :data:`TRAIN_FIRST`); each
+slopes and kicks) at seeds that no judge uses (from :data:`~imitwalk.sim.seeds.TRAIN_FIRST`); each
 generation draws new ones. A candidate's cost is the mean of its walks'
 (:func:`~imitwalk.step.episode.score_walk`: falls first, then progress and heading).
 
@@ -30,6 +30,8 @@ import pickle
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,16 +40,16 @@ from imitwalk.fileio import atomic_write
 from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
+from imitwalk.sim.seeds import FINAL_FIRST, TRAIN_FIRST
 from imitwalk.step.episode import StepJob, StepScore, mean_cost, run_step_job
 from imitwalk.step.gains import BOUNDS, StepGains
 from imitwalk.step.style import GaitStyle
 
-__all__ = ["SEARCHED", "TRAIN_FIRST", "StepLearnConfig", "StepLearnResult", "learn_step"]
+if TYPE_CHECKING:  # the caller loads the protocol (its draws need SciPy)
+    from imitwalk.sim.protocol import Protocol, RobotDraw
 
-#: Training robots are drawn from this seed on (judges use 0 … 39, validation 300 000 on).
-TRAIN_FIRST = 1001
-#: The final choice's robots, after the generations' ones.
-FINAL_FIRST = 200_001
+__all__ = ["SEARCHED", "StepLearnConfig", "StepLearnResult", "learn_step"]
+
 #: How many fewer final robots a generation's winner must fell than the start to replace
 #: it (one fall is within the noise of ten robots).
 KEEP_MARGIN = 2
@@ -151,12 +153,18 @@ def _checkpoint(rd: RunDir) -> dict:
     return saved
 
 
-def _robots(protocol, robot: Robot, first: int, count: int, seconds: float):
+def _robots(
+    protocol: Protocol, robot: Robot, first: int, count: int, seconds: float
+) -> list[RobotDraw]:
     return [protocol.draw(first + i, robot, seconds=seconds) for i in range(count)]
 
 
 def _walk_all(
-    candidates: list[StepGains], draws, robot: Robot, styles: list[GaitStyle], cfg: StepLearnConfig
+    candidates: list[StepGains],
+    draws: list[RobotDraw],
+    robot: Robot,
+    styles: list[GaitStyle],
+    cfg: StepLearnConfig,
 ) -> list[list[StepScore]]:
     """Every candidate on every robot; robot ``i`` walks ``styles[i % len(styles)]``."""
     jobs = [
@@ -173,8 +181,8 @@ def learn_step(
     robot: Robot,
     style: GaitStyle | list[GaitStyle],
     cfg: StepLearnConfig,
-    run_dir,
-    protocol,
+    run_dir: str | Path,
+    protocol: Protocol,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
     start: StepGains | None = None,
@@ -182,7 +190,7 @@ def learn_step(
     """Learn the gains of ``style`` on ``robot`` (see the module doc; a list of styles:
     the training robots take them in turn), checkpointed in
     ``run_dir`` after every generation; ``protocol`` (a
-    :class:`~imitwalk.judge.protocol.Protocol`, the one ``cfg.protocol`` names) draws
+    :class:`~imitwalk.sim.protocol.Protocol`, the one ``cfg.protocol`` names) draws
     the training robots; ``start``: where the search starts (default: the shipped
     gains).
 
@@ -248,7 +256,8 @@ def learn_step(
             "sim_seconds": spent,
             "wall": time.perf_counter() - t0,
         }
-        atomic_write(rd.file("cma.pkl"), lambda tmp, s=state: tmp.write_bytes(pickle.dumps(s)))
+        # mypy cannot infer a lambda with a default argument against a one-argument Callable
+        atomic_write(rd.file("cma.pkl"), lambda tmp, s=state: tmp.write_bytes(pickle.dumps(s)))  # type: ignore[misc]
         rd.write_log(log)
     finalists = {"start": start}
     for entry in log:

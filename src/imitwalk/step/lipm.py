@@ -39,7 +39,13 @@ def omega_of(com_height: float) -> float:
     return float(np.sqrt(GRAVITY / com_height))
 
 
-def dcm_after(xi, p_from, p_to, duration, omega: float):
+def dcm_after(
+    xi: np.ndarray,
+    p_from: np.ndarray,
+    p_to: np.ndarray,
+    duration: float | np.ndarray,
+    omega: float,
+) -> np.ndarray:
     """The DCM after ``duration`` [s] while the ZMP moves linearly from ``p_from`` to
     ``p_to`` (closed form, see the module doc).
 
@@ -55,7 +61,13 @@ def dcm_after(xi, p_from, p_to, duration, omega: float):
     return p_to + slope + (xi - p_from - slope) * np.exp(omega * h)
 
 
-def dcm_before(xi_end, p_from, p_to, duration, omega: float):
+def dcm_before(
+    xi_end: np.ndarray,
+    p_from: np.ndarray,
+    p_to: np.ndarray,
+    duration: float | np.ndarray,
+    omega: float,
+) -> np.ndarray:
     """The DCM at the start of a linear ZMP segment that ends at ``xi_end``: the inverse
     of :func:`dcm_after` (the backward recursion of the DCM plan)."""
     h = np.asarray(duration, dtype=float)[..., None]
@@ -63,7 +75,9 @@ def dcm_before(xi_end, p_from, p_to, duration, omega: float):
     return p_from + slope + (xi_end - p_to - slope) * np.exp(-omega * h)
 
 
-def lipm_step(c, v, p, dt: float, omega: float) -> tuple[np.ndarray, np.ndarray]:
+def lipm_step(
+    c: np.ndarray, v: np.ndarray, p: np.ndarray, dt: float, omega: float
+) -> tuple[np.ndarray, np.ndarray]:
     """The centre of mass after ``dt`` [s] with the ZMP held at ``p`` (exact).
 
     Args:

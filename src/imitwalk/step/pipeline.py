@@ -18,26 +18,35 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.errors import MocapError, RunError
+from imitwalk.retarget.provenance import Provenance
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
 
+if TYPE_CHECKING:
+    from imitwalk.mocap import Motion
+    from imitwalk.sim.protocol import Protocol
+    from imitwalk.step.style import GaitStyle
+
 __all__ = ["gait_from_motion", "learn", "learn_clip"]
 
 
 def gait_from_motion(
-    motion, robot: Robot, settings: dict | None = None, dt: float = 0.01
+    motion: Motion, robot: Robot, named: Provenance | None = None, dt: float = 0.01
 ) -> StepGait:
     """The :class:`~imitwalk.step.gait.StepGait` of ``motion`` on ``robot`` at scale 1:
     of its straight cycles, or if it has none, of its turning ones (a turning gait, its
     turn per cycle read from the clip: :attr:`~imitwalk.retarget.template.GaitTemplate.turn_deg`).
+    ``named``: the robot as the command named it (default: its name).
 
     Raises:
         MocapError: the clip holds no steady walking cycle, straight or turning.
@@ -58,7 +67,12 @@ def gait_from_motion(
         dt=dt,
         source=str(motion.source),
         cycles=np.asarray(template.cycles, dtype=int).reshape(-1, 2),
-        settings=dict(settings or {"robot": robot.name, "joint_map": None}),
+        provenance=replace(
+            named or Provenance(robot=robot.name),
+            motion_format=motion.format,
+            motion_fps=motion.fps,
+            filled=tuple(motion.filled),
+        ),
     )
 
 
@@ -66,8 +80,8 @@ def learn_clip(
     gait: StepGait,
     robot: Robot,
     cfg: StepLearnConfig,
-    out,
-    protocol,
+    out: str | Path,
+    protocol: Protocol,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> LearnSummary:
@@ -110,13 +124,13 @@ def learn_clip(
 
 
 def learn(
-    clip=None,
+    clip: Motion | str | Path | None = None,
     robot: Robot | str = "hoap2",
-    out="RUN",
+    out: str | Path = "RUN",
     cfg: StepLearnConfig | None = None,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
-    settings: dict | None = None,
+    named: Provenance | None = None,
 ) -> LearnSummary:
     """The product as one call: ``clip`` learned as a stepping gait on ``robot`` into the
     run folder ``out``, exactly as ``imitwalk learn CLIP --out OUT`` does.
@@ -127,13 +141,13 @@ def learn(
             embedded walk); robot: a :class:`~imitwalk.robots.Robot` or its name or
             file; cfg: the learning settings (default :class:`StepLearnConfig`);
             resume: continue an interrupted run (its clip and gait are its own);
-            settings: where the robot came from, for the run folder (``robot``,
-            ``joint_map``; default: its name).
+            named: the robot as the command named it, for the run folder (default: its
+            name).
     """
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.mocap import Motion, default_clip
     from imitwalk.retarget.motionfiles import load_clip
     from imitwalk.robots import load_robot
+    from imitwalk.sim.protocol import load_protocol
 
     robot = load_robot(robot) if isinstance(robot, str) else robot
     cfg = cfg or StepLearnConfig()
@@ -142,7 +156,7 @@ def learn(
         gait = StepGait.load(RunDir(out).file("style.json"))
     else:
         motion = clip if isinstance(clip, Motion) else load_clip(clip or default_clip(), robot)
-        gait = gait_from_motion(motion, robot, settings)
+        gait = gait_from_motion(motion, robot, named)
         st = gait.style
         if progress is not None:
             progress(
@@ -153,7 +167,7 @@ def learn(
     return learn_clip(gait, robot, cfg, out, protocol, resume=resume, progress=progress)
 
 
-def _turning(style) -> str:
+def _turning(style: GaitStyle) -> str:
     """How the style turns, for the learner's progress line ("" for a straight walk)."""
     if not style.turn:
         return ""

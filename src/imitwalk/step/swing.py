@@ -37,8 +37,14 @@ class SwingFoot:
     """
 
     def __init__(
-        self, shape_x, shape_z, clearance: float, late_s: float, rate: float, limit: float
-    ):
+        self,
+        shape_x: np.ndarray,
+        shape_z: np.ndarray,
+        clearance: float,
+        late_s: float,
+        rate: float,
+        limit: float,
+    ) -> None:
         self.shape_x, self.shape_z = np.asarray(shape_x), np.asarray(shape_z)
         self._gx = np.linspace(0.0, 1.0, len(self.shape_x))  # σ of each profile sample
         self._gz = np.linspace(0.0, 1.0, len(self.shape_z))
@@ -59,7 +65,7 @@ class SwingFoot:
         yaw: float,
         measured: np.ndarray,
         dt: float,
-        slope=(0.0, 0.0),
+        slope: tuple[float, float] | np.ndarray = (0.0, 0.0),
     ) -> FootPose:
         """Move the foot for the tick ending ``elapsed`` [s] into a swing of ``duration``
         [s] towards ``landing`` ``(2,)`` [m] and heading ``yaw`` [rad]; ``measured``

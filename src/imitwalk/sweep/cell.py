@@ -79,9 +79,10 @@ def run_cell(job: CellJob) -> dict[str, Any]:
     """Learn and judge ``job``'s cell; its row (also written to ``row.json``)."""
     os.environ["IMITWALK_WORKERS"] = "1"  # the sweep runs cells side by side
     from imitwalk.config import apply_overrides
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.retarget.provenance import Provenance
     from imitwalk.robots import load_robot
+    from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
     from imitwalk.step.pipeline import learn
 
@@ -93,7 +94,7 @@ def run_cell(job: CellJob) -> dict[str, Any]:
         cfg = apply_overrides(StepLearnConfig(seed=c.seed), list(c.settings))
         resume = (run_dir / "config.json").is_file()
         clip = None if c.clip == DEFAULT_CLIP else c.clip
-        where = {"robot": c.robot, "joint_map": None}
+        where = Provenance(robot=c.robot)
         summary = learn(clip, robot, str(run_dir), cfg, resume, None, where)
         verdict = judge_protocol(
             str(run_dir),

@@ -108,8 +108,8 @@ def _resolve(path: str, base: Path, what: str, where: str) -> str:
 def _check(cfg: SweepConfig, where: str) -> None:
     """Refuse, before any cell runs, what learn or the judge would refuse."""
     from imitwalk.config import apply_overrides
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.robots import load_robot
+    from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
 
     try:

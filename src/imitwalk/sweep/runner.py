@@ -14,6 +14,7 @@ counts the cells.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -143,7 +144,7 @@ class _bar:
         self.show, self.total, self.done = show, total, done
         self.progress: Any = None
 
-    def __enter__(self):
+    def __enter__(self) -> Callable[[], None]:
         if self.show:
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
@@ -158,6 +159,6 @@ class _bar:
         if self.progress is not None:
             self.progress.advance(self.task)
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         if self.progress is not None:
             self.progress.stop()

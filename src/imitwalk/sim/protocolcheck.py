@@ -1,8 +1,8 @@
 """A protocol file's checks: every key, factor and range, one line per fault (pure Python).
 
-:func:`checked` validates a parsed file for :func:`imitwalk.judge.protocol.load_protocol`;
+:func:`checked` validates a parsed file for :func:`imitwalk.sim.protocol.load_protocol`;
 :data:`FACTORS` lists the factors a protocol may draw and the keys of each (their meaning
-is in :mod:`imitwalk.judge.protocol`).
+is in :mod:`imitwalk.sim.protocol`).
 """
 
 from __future__ import annotations
@@ -38,9 +38,9 @@ def fail(where: str, what: str) -> ConfigError:
     return ConfigError(f"protocol {where}: {what}")
 
 
-def checked(data, where: str) -> dict:
+def checked(data: object, where: str) -> dict:
     """``data`` (a parsed protocol file from ``where``) validated: the fields of a
-    :class:`~imitwalk.judge.protocol.Protocol`, factors as floats.
+    :class:`~imitwalk.sim.protocol.Protocol`, factors as floats.
 
     Raises:
         ConfigError: one line naming what is wrong (listing the valid keys or factors).

@@ -1,6 +1,6 @@
 """Seeded mutations of the real mocap files, and a time-limited run of the reader on each.
 
-Used by ``tests/test_fuzz_mocap.py`` and ``bench/fuzz_mocap.py``. A case is ``(format,
+Used by ``tests/test_fuzz_mocap.py``, and a command line (below). A case is ``(format,
 index)``; its mutation is drawn from ``random.Random(f"{format}:{index}")``, so every
 run makes the same cases. :func:`run_case` gives one of
 
@@ -13,14 +13,26 @@ run makes the same cases. :func:`run_case` gives one of
 
 The seeds are the real files of ``../shared/mocap``, cut short where reading them whole
 would take most of the time (the AMC to its first 120 frames, the BVH files to 121).
+
+As a command line, from the repository root, it runs the cases of the test and prints
+JSON: per format the cases, project errors, other exceptions, accepted results,
+accepted but implausible or non-finite ones, hangs (over the time limit), the wall time
+and the first few failures. Needs the shared fixtures (``$IMITWALK_SHARED_MOCAP``, else
+``../shared/mocap`` beside the repository)::
+
+    python -m tests.helpers.fuzz_mocap [--cases 2000] [--formats bvh amc c3d deepmimic]
 """
 
 from __future__ import annotations
 
+import argparse
 import json
+import os
 import random
 import re
 import signal
+import tempfile
+import time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -397,3 +409,50 @@ def run_case(case: Case, folder: Path, limit_s: float = 10.0) -> tuple[str, str]
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+#: The repository's root (this file is ``tests/helpers/fuzz_mocap.py``).
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line (see the module's docstring); prints the JSON report, returns 0."""
+    ap = argparse.ArgumentParser(
+        prog="python -m tests.helpers.fuzz_mocap",
+        description="The mocap readers against seeded mutations of the real files: "
+        "counts per format.",
+    )
+    ap.add_argument("--cases", type=int, default=2000, help="cases per format (2000)")
+    ap.add_argument("--formats", nargs="+", default=list(FORMATS), choices=FORMATS)
+    ap.add_argument("--limit", type=float, default=10.0, help="time limit per case [s] (10)")
+    args = ap.parse_args(argv)
+    shared = Path(os.environ.get("IMITWALK_SHARED_MOCAP", ROOT.parent / "shared" / "mocap"))
+    pool = seeds(shared)
+    out = {}
+    for fmt in args.formats:
+        counts = dict.fromkeys(("error", "other", "accepted", "implausible", "hang"), 0)
+        failures = []
+        t = time.perf_counter()
+        with tempfile.TemporaryDirectory() as tmp:
+            for i in range(args.cases):
+                case = make_case(fmt, i, pool)
+                outcome, detail = run_case(case, Path(tmp), args.limit)
+                counts[outcome] += 1
+                if outcome not in ("error", "accepted") and len(failures) < 5:
+                    failures.append(f"case {i} ({case.mutation}): {outcome}: {detail}")
+        out[fmt] = {
+            "cases": args.cases,
+            "project_errors": counts["error"],
+            "other_exceptions": counts["other"],
+            "accepted": counts["accepted"],
+            "accepted_implausible": counts["implausible"],
+            "hangs": counts["hang"],
+            "wall_seconds": round(time.perf_counter() - t, 1),
+            "failures": failures,
+        }
+    print(json.dumps(out, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

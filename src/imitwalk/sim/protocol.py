@@ -1,6 +1,6 @@
 """Named robustness protocols: which robots a controller is judged on (pure NumPy).
 
-A protocol is a versioned JSON file (``imitwalk/judge/protocols/NAME.json``, or a user's own
+A protocol is a versioned JSON file (``imitwalk/sim/protocols/NAME.json``, or a user's own
 file of the same form) that lists every *factor* it draws, each with its range and
 where that range comes from. :meth:`Protocol.draw` turns a seed into one robot: the
 :class:`~imitwalk.sim.types.SimOptions` it is simulated with and, per factor, how far
@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
@@ -49,20 +50,21 @@ import numpy as np
 from scipy.stats import chi2, norm
 
 from imitwalk.errors import ConfigError, unknown_name
-from imitwalk.judge.protocolcheck import FACTORS, checked, fail
+from imitwalk.sim.protocolcheck import FACTORS, checked, fail
+from imitwalk.sim.seeds import DRAW_STREAM
 from imitwalk.sim.types import SimOptions, jitter_draws
 
 __all__ = ["FACTORS", "PROTOCOLS", "Protocol", "RobotDraw", "load_protocol"]
 
-#: The stream of each factor that does not share the legacy one (see the module doc).
+#: The stream of each factor that does not share :func:`~imitwalk.sim.perturb.perturbed`'s
+#: (see the module doc).
 _STREAM = {"torso_com": 1, "servo_delay": 2, "slope": 3, "pushes": 4, "cross_slope": 5}
-_LEGACY = 20070106
 
 #: The protocols shipped with imitwalk, by name.
 PROTOCOLS = tuple(
     sorted(
         f.name[:-5]
-        for f in resources.files("imitwalk.judge.protocols").iterdir()
+        for f in resources.files("imitwalk.sim.protocols").iterdir()
         if f.name.endswith(".json")
     )
 )
@@ -103,7 +105,11 @@ class Protocol:
     path: str = ""
 
     def draw(
-        self, seed: int, robot, base: SimOptions | None = None, seconds: float = 30.0
+        self,
+        seed: int,
+        robot: Any,  # a robots.Robot (this NumPy-only module may not import robots' MuJoCo)
+        base: SimOptions | None = None,
+        seconds: float = 30.0,
     ) -> RobotDraw:
         """Robot ``seed`` (``robot``: its height and bodies scale and count the draws;
         ``base``: options kept, e.g. rates or the reference's own slope; ``seconds``:
@@ -114,9 +120,9 @@ class Protocol:
         f = self.factors
         dev: dict[str, float] = {}
         opt: dict[str, Any] = {"seed": seed}
-        legacy = np.random.default_rng([seed, _LEGACY])
-        twist = np.concatenate([legacy.normal(0, 1, 3), legacy.normal(0, 1, 3)])
-        u_friction = legacy.random()
+        shared = np.random.default_rng([seed, DRAW_STREAM])
+        twist = np.concatenate([shared.normal(0, 1, 3), shared.normal(0, 1, 3)])
+        u_friction = shared.random()
         if "initial_twist" in f:
             sd = np.repeat([f["initial_twist"]["linear"], f["initial_twist"]["angular"]], 3)
             opt["init_twist"] = tuple((twist * sd).tolist())
@@ -170,9 +176,11 @@ class Protocol:
         return RobotDraw(seed, replace(base, **opt), dev)
 
     def _stream(self, seed: int, factor: str) -> np.random.Generator:
-        return np.random.default_rng([seed, _LEGACY, _STREAM[factor]])
+        return np.random.default_rng([seed, DRAW_STREAM, _STREAM[factor]])
 
-    def _pushes(self, seed: int, height: float, seconds: float):
+    def _pushes(
+        self, seed: int, height: float, seconds: float
+    ) -> tuple[tuple[tuple[float, float, float], ...], float]:
         p = self.factors["pushes"]
         rng = self._stream(seed, "pushes")
         top = p["max_speed"] * math.sqrt(height / p["at_height_m"])
@@ -188,7 +196,7 @@ class Protocol:
         dev = float(max(fractions) ** len(fractions)) if fractions else 0.0
         return tuple(out), dev
 
-    def only(self, factors) -> Protocol:
+    def only(self, factors: Collection[str]) -> Protocol:
         """This protocol with only ``factors`` drawn (the others at nominal; each kept
         factor draws exactly as in the full protocol).
 
@@ -236,7 +244,7 @@ def load_protocol(name_or_path: str | Path) -> Protocol:
     """
     text = str(name_or_path)
     if text in PROTOCOLS:
-        raw = resources.files("imitwalk.judge.protocols").joinpath(f"{text}.json").read_text()
+        raw = resources.files("imitwalk.sim.protocols").joinpath(f"{text}.json").read_text()
         where = text
     elif text.endswith(".json"):
         path = Path(text)

@@ -40,7 +40,9 @@ class ModelRun:
         return {"seed": self.seed, "walked": self.walked, **self.metrics.to_dict()}
 
 
-def _one(args) -> ModelRun:
+def _one(
+    args: tuple[Robot, np.ndarray, np.ndarray, SimOptions, _Expected, int, str],
+) -> ModelRun:
     robot, q, q0, options, expected_fn, seed, engine = args
     plant = make_plant(robot, options, engine)
     ro = playback(plant, q, q0=q0)

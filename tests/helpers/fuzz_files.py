@@ -16,15 +16,26 @@ line), ``"accepted"`` (a reference that plays: its trajectory, summary and comma
 valid; a run file read as a record; a path that is then written), ``"wrong"`` (accepted
 but not usable, or an output refused after leaving something behind), ``"other"`` (any
 other exception: a traceback on the CLI) or ``"hang"`` (past the time limit).
+
+Used by ``tests/test_fuzz_files.py`` and ``tests/test_cli_hostile_files.py``. As a command
+line, from the repository root, it runs the same cases and prints JSON: per input the
+cases, the counts of each outcome, the first few failures and the wall time. The
+reference the mutations start from is retargeted first (the default clip, no search)::
+
+    python -m tests.helpers.fuzz_files [--cases 2000] [--inputs reference run out]
 """
 
 from __future__ import annotations
 
+import argparse
+import contextlib
 import io
 import json
 import random
 import shutil
 import signal
+import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -172,7 +183,7 @@ def _check_reference(path: Path) -> str:
     if q.shape[1] != len(ref.joint_names) or not np.isfinite(q).all():
         return "wrong"
     json.dumps(ref.summary(), allow_nan=True, default=str)
-    ref.gait_command()
+    ref.command.describe()
     ref.sim_options()
     ref.expected_distance(scale, 1.0)
     return "accepted"
@@ -265,3 +276,38 @@ def fuzz(kind: str, cases: range, seed: bytes, folder: Path) -> dict:
         if outcome not in ("error", "accepted") and len(failures) < 20:
             failures.append(f"case {i} ({case.name}: {case.mutation}): {outcome}: {detail}")
     return {"counts": counts, "failures": failures}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line (see the module's docstring); prints the JSON report, returns 0."""
+    from imitwalk.cli.main import main as cli
+
+    ap = argparse.ArgumentParser(
+        prog="python -m tests.helpers.fuzz_files",
+        description="What imitwalk reads back and writes, against seeded mutations: "
+        "counts per input.",
+    )
+    ap.add_argument("--cases", type=int, default=2000, help="cases per input (2000)")
+    ap.add_argument("--inputs", nargs="+", default=list(INPUTS), choices=INPUTS)
+    args = ap.parse_args(argv)
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        ref = Path(tmp) / "ref.npz"
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            assert cli(["retarget", "--out", str(ref), "--no-search", "--set", "scales=[0.5]"]) == 0
+        seed = ref.read_bytes()
+        for kind in args.inputs:
+            t = time.perf_counter()
+            report = fuzz(kind, range(args.cases), seed, Path(tmp) / "case")
+            report["failures"] = report["failures"][:5]
+            out[kind] = {
+                "cases": args.cases,
+                **report,
+                "wall_seconds": round(time.perf_counter() - t, 1),
+            }
+    print(json.dumps(out, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -34,8 +34,11 @@ from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
+from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -50,6 +53,10 @@ from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir
 from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
+
+if TYPE_CHECKING:
+    from imitwalk.retarget.reference import Reference
+    from imitwalk.retarget.search import Walker
 
 __all__ = [
     "PASSES",
@@ -78,7 +85,13 @@ class LawWalker:
     engine: str = "mujoco"
 
     def __call__(
-        self, ref, robot: Robot, scale: float, seed: int, options: SimOptions, seconds: float
+        self,
+        ref: Reference,
+        robot: Robot,
+        scale: float,
+        seed: int,
+        options: SimOptions,
+        seconds: float,
     ) -> WalkMetrics:
         job = TickJob(
             "",
@@ -96,7 +109,7 @@ class LawWalker:
         return tick_walk_metrics(job, ref)
 
 
-def law_walker(run_dir) -> LawWalker:
+def law_walker(run_dir: str | Path) -> LawWalker:
     """The :class:`LawWalker` of the finished per-tick run in ``run_dir``."""
     rd = RunDir(run_dir)
     settings = rd.read_summary().reference_settings or {}
@@ -177,12 +190,12 @@ def pick(verdicts: list[PassVerdict]) -> str:
 
 
 def learn_clip(
-    make_reference,
+    make_reference: Callable[[Walker | None], Reference],
     robot: Robot,
     cfg: TickLearnConfig,
-    run_dir,
+    run_dir: str | Path,
     resume: bool = False,
-    progress=None,
+    progress: Callable[[str], None] | None = None,
 ) -> tuple[LearnSummary, Choice]:
     """Learn the two passes (module docstring) into ``run_dir`` and keep the better.
 
@@ -226,7 +239,7 @@ def learn_clip(
             ref = Reference.load(rd.file("reference.npz"))
         else:
             ref = make_reference(walker)
-        searched[name] = float((ref.search or {}).get("sim_seconds", 0.0))
+        searched[name] = ref.search.sim_seconds if ref.search is not None else 0.0
         twin = next((n for n, r in refs.items() if same_gait(ref, r)), "")
         refs[name] = ref
         if twin:  # learning it again would repeat the twin's learning to the digit
@@ -244,17 +257,13 @@ def learn_clip(
     return summaries[choice.kept], choice
 
 
-def same_gait(a, b) -> bool:
+def same_gait(a: Reference, b: Reference) -> bool:
     """True if two references of one clip and robot play the same gait: the same
     parameters and the same joint trajectories at every scale (their search reports may
     differ)."""
-    return (
-        a.params == b.params
-        and a.scale_params == b.scale_params
-        and all(
-            np.array_equal(getattr(a, k), getattr(b, k))
-            for k in ("scales", "loops", "starts", "start_travel")
-        )
+    return a.params == b.params and all(
+        np.array_equal(getattr(a, k), getattr(b, k))
+        for k in ("scales", "loops", "starts", "start_travel")
     )
 
 
@@ -265,13 +274,13 @@ def _judge(
     summaries: dict,
     searched: dict,
     same: dict,
-    say,
+    say: Callable[[str], None],
 ) -> Choice:
     """Each pass's learned controller on the choice's training robots; ``searched``: each
     pass's reference search's simulated seconds [s]; ``same``: the passes that share an
     earlier pass's gait, and whose."""
-    from imitwalk.judge.protocol import load_protocol
     from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.sim.protocol import load_protocol
 
     c = cfg.choice
     protocol = replace(load_protocol(cfg.train_protocol), engine=cfg.engine)  # learned there
@@ -344,7 +353,7 @@ def _keep(root: RunDir, name: str) -> None:
         key=lambda p: p.name == "metrics.json",
     )
     for p in files:
-        atomic_write(root.file(p.name), lambda tmp, p=p: _link(p, tmp))
+        atomic_write(root.file(p.name), partial(_link, p))
 
 
 def _link(src: Path, dst: Path) -> None:

@@ -11,23 +11,31 @@ an :class:`~imitwalk.errors.ImitwalkError` in one line that names the file, or g
 mass, height, timestep, joint ranges and servo gains are within the bounds of
 :mod:`imitwalk.robots.plausible` (``accepted_implausible`` otherwise), and whose
 ``robot info`` is valid JSON. Cases run in a worker process with a time limit, so a
-hang is counted, not waited for. Used by ``tests/test_fuzz_robot.py`` and
-``bench/fuzz_robot.py``.
+hang is counted, not waited for. Used by ``tests/test_fuzz_robot.py``.
+
+As a command line, from the repository root, it runs the cases and prints one JSON
+object: per input (the joint map, the MJCF) how many cases ended in each outcome, and the
+first failing cases::
+
+    python -m tests.helpers.fuzz_robot [--cases 4000] [--seed 1] [--timeout 20]
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import multiprocessing as mp
 import random
 import re
 import shutil
 import tempfile
+import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-HOAP2 = Path(__file__).resolve().parents[1] / "src" / "imitwalk" / "robots" / "hoap2"
+#: hoap2's files in the repository (this file is ``tests/helpers/fuzz_robot.py``).
+HOAP2 = Path(__file__).resolve().parents[2] / "src" / "imitwalk" / "robots" / "hoap2"
 OUTCOMES = (
     "project_error",
     "accepted",
@@ -321,3 +329,24 @@ def fuzz(n: int, seed: int = 0, timeout: float = 20.0) -> dict:
     finally:
         runner.close()
     return {"cases": n, "seed": seed, "timeout_s": timeout, "counts": counts, "failures": failures}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line (see the module's docstring); prints the JSON report, returns 0."""
+    ap = argparse.ArgumentParser(
+        prog="python -m tests.helpers.fuzz_robot",
+        description="Fuzz the robot loader: seeded mutations of hoap2's joint map and MJCF.",
+    )
+    ap.add_argument("--cases", type=int, default=4000, help="cases, half per input (4000)")
+    ap.add_argument("--seed", type=int, default=1, help="random seed (1)")
+    ap.add_argument("--timeout", type=float, default=20.0, help="time limit per case [s] (20)")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    out = fuzz(args.cases, args.seed, args.timeout)
+    out["wall_seconds"] = round(time.perf_counter() - t0, 1)
+    print(json.dumps(out, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
