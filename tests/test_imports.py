@@ -15,6 +15,7 @@ NUMPY_ONLY = (
     "balance.feedback",
     "balance.lqr",
     "balance.tickconfig",
+    "balance.ticklog",
     "balance.tickmodel",
     "config",
     "evidence",

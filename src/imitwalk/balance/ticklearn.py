@@ -43,6 +43,13 @@ from pathlib import Path
 from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.lqr import Costs, horizon_gains
 from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.ticklog import (
+    LogEntry,
+    ScheduleEntry,
+    TrialsEntry,
+    TrustEntry,
+    entry_from_dict,
+)
 from imitwalk.balance.tickmodel import PhaseModel, nominal_profile
 from imitwalk.balance.tickrun import Trial, best, most_falls, summarize
 from imitwalk.balance.tickstore import feedback_law, load_learned, save_learned, unstack_episodes
@@ -76,19 +83,22 @@ def _learned_law(lr: Learner, episodes: list[Episode]) -> tuple[FeedbackLaw, Pha
     return replace(shell, gains=horizon_gains(model, costs)), model
 
 
-def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> FeedbackLaw | None:
+def _schedule(
+    lr: Learner, state: TickProgress, log: list[LogEntry], data: list
+) -> FeedbackLaw | None:
     """Stage 2: execute, record, fit, derive gains, scale up (paper §5–6)."""
     cfg = lr.cfg
     base = feedback_law(cfg, state.gains, state.profiles)
     learned, model = load_learned(lr.rd), None
     if data and state.scale_index < len(lr.scales):  # resumed: the model of the last iteration
-        last = log[-1]["scale"] if log and log[-1].get("stage") == "schedule" else None
+        last = log[-1].scale if log and isinstance(log[-1], ScheduleEntry) else None
         if last is not None:
             learned, model = _learned_law(lr, [e for s, e in data if abs(s - last) < 1e-9])
     while state.scale_index < len(lr.scales):
         scale = lr.scales[state.scale_index]
         explore = cfg.lqr.explore if state.iteration == 0 else 0.0
-        n = sum(e["stage"] == "schedule" for e in log)  # not moved by how many trials came first
+        # the iterations so far (not moved by how many trials came first)
+        n = sum(isinstance(e, ScheduleEntry) for e in log)
         draws = lr.robots(cfg.robots, TRAIN_SEED_BASE + 1 + cfg.robots * n, cfg.seconds)
         laws = [base] if learned is None else [base, learned]
         if learned is None:  # the first iteration records the trial-picked law's channels
@@ -104,19 +114,12 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
         near = [e for s, e in data if abs(s - scale) < 1e-9]
         learned, model = _learned_law(lr, near)
         fell = sum(r.fell for r in res)
-        entry = {
-            "stage": "schedule",
-            "scale": scale,
-            "iteration": state.iteration,
-            "explore": explore,
-            **summarize(res).to_dict(),
-            "held_out": held,
-        }
+        entry = ScheduleEntry(scale, state.iteration, explore, summarize(res), held)
         log.append(entry)
         ratio = f"{held['ratio_to_persistence']:.2f}" if held else "  - "
         lr.say(
             f"scale {scale:.2f} it {state.iteration} | fell {fell}/{len(res)} | "
-            f"cost {entry['cost']:.3f} | model err / persistence {ratio}"
+            f"cost {entry.walks.cost:.3f} | model err / persistence {ratio}"
         )
         if explore == 0.0 and fell == 0:
             state.passed.append(scale)
@@ -132,7 +135,9 @@ def _schedule(lr: Learner, state: TickProgress, log: list, data: list) -> Feedba
     return learned
 
 
-def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | None) -> None:
+def _trust(
+    lr: Learner, state: TickProgress, log: list[LogEntry], learned: FeedbackLaw | None
+) -> None:
     """Stage 3: how much of the learned law to keep, by the trials at the trials' scale
     (the law the schedule learned at the highest scale it passed) on the heading trials'
     robots: their 30 s walks are the evaluation's length, and the trial-picked law alone
@@ -155,14 +160,8 @@ def _trust(lr: Learner, state: TickProgress, log: list, learned: FeedbackLaw | N
         table.append((float(frac), run))
     kept = best(table)[0]
     state.trust, state.stage = kept, "done"
-    log.append(
-        {
-            "stage": "trust",
-            "scale": lr.trial_scale(state),
-            "kept": kept,
-            "table": [{"fraction": f, **t.summary().to_dict()} for f, t in table],
-        }
-    )
+    rows = [{"fraction": f, **t.summary().to_dict()} for f, t in table]
+    log.append(TrustEntry(lr.trial_scale(state), kept, rows))
     say_table(lr, f"trust at {lr.trial_scale(state):g}: kept {kept:g}", table)
 
 
@@ -186,7 +185,8 @@ def learn_tick(
         "robot": robot.name,
         "learner": "tick",
     }
-    saved, log = rd.start(cfg_json, ref, resume)
+    saved, lines = rd.start(cfg_json, ref, resume)
+    log = [entry_from_dict(line) for line in lines]
     state = TickProgress(**saved) if saved else TickProgress()
     data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []
     lr = Learner(ref, robot, config, rd, progress)
@@ -200,8 +200,8 @@ def learn_tick(
     if state.stage == "trust":
         _trust(lr, state, log, learned)
         checkpoint(lr, state, log, data)
-    kept = [t for t in log if t["stage"] in ("trials", "trust")][-1]
-    row = next(r for r in kept["table"] if r.get("value", r.get("fraction")) == kept["kept"])
+    kept = [t for t in log if isinstance(t, TrialsEntry | TrustEntry)][-1]
+    row = next(r for r in kept.table if r.get("value", r.get("fraction")) == kept.kept)
     trial_falls, trial_scale = int(row["falls"]), lr.trial_scale(state)
     walked = [trial_scale] if trial_falls == 0 else []
     reached = max([*state.passed, *walked], default=lr.scales[0])
@@ -209,7 +209,7 @@ def learn_tick(
         learner="tick",
         scale_reached=reached,
         scales_passed=state.passed,
-        iterations=sum(1 for e in log if e["stage"] == "schedule"),
+        iterations=sum(isinstance(e, ScheduleEntry) for e in log),
         sim_seconds_used_for_learning=state.sim_seconds,
         wall_seconds_for_learning=state.wall_seconds,
         config=to_dict(config),

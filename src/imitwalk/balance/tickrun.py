@@ -6,12 +6,13 @@ The learner (:mod:`imitwalk.balance.ticklearn`) runs many of these in parallel
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imitwalk.balance.feedback import Episode, FeedbackLaw, TickPolicy
+from imitwalk.balance.ticklog import WalkSummary
 from imitwalk.parallel import abandoned
 from imitwalk.robots import Robot
 from imitwalk.sim.metrics import WalkMetrics
@@ -25,7 +26,6 @@ __all__ = [
     "TickJob",
     "TickResult",
     "Trial",
-    "WalkSummary",
     "best",
     "blind",
     "most_falls",
@@ -155,25 +155,6 @@ def run_tick_episode(job: TickJob) -> TickResult:
         cost=cost if not m.fell else float("inf"),
         episode=policy.episode() if job.record else None,
     )
-
-
-@dataclass(frozen=True)
-class WalkSummary:
-    """Some walks in a few numbers: falls, robots, mean Γ of the robots that stayed up
-    [rad²/s²] (``inf`` if none did), seconds walked in all [s], mean forward distance [m],
-    mean |yaw drift| [deg] and that mean's standard error [deg] (0 below two walks)."""
-
-    falls: int
-    robots: int
-    cost: float
-    walked_s: float
-    distance_m: float
-    abs_yaw_deg: float
-    abs_yaw_se_deg: float
-
-    def to_dict(self) -> dict:
-        """Plain-JSON dictionary (a row of the learning log's tables)."""
-        return asdict(self)
 
 
 def summarize(results: list[TickResult]) -> WalkSummary:

@@ -21,6 +21,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 from imitwalk.balance.feedback import Episode, FeedbackLaw
 from imitwalk.balance.tickconfig import TickLearnConfig
+from imitwalk.balance.ticklog import LogEntry, TrialsEntry
 from imitwalk.balance.tickmodel import nominal_profile
 from imitwalk.balance.tickrun import (
     TickJob,
@@ -256,7 +257,7 @@ def _table(
             return table
 
 
-def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
+def _reference_settings(lr: Learner, state: TickProgress, log: list[LogEntry]) -> None:
     """Stage 1's first choices: how the reference is played, one setting at a time, with
     no feedback, at the trial scale, on the balance gains' robots
     (``trials.balance_protocol``, whose servos sag unevenly: what the feedforward is for).
@@ -283,14 +284,7 @@ def _reference_settings(lr: Learner, state: TickProgress, log: list) -> None:
         state.settings[name] = kept = best(table)[0]
         rows = [{"value": v, **t.summary().to_dict()} for v, t in table]
         log.append(
-            {
-                "stage": "trials",
-                "gain": name,
-                "kept": kept,
-                "scale": lr.trial_scale(state),
-                "protocol": cfg.trials.balance_protocol,
-                "table": rows,
-            }
+            TrialsEntry(name, kept, lr.trial_scale(state), cfg.trials.balance_protocol, rows)
         )
         say_table(lr, f"trials: reference {name} = {state.settings[name]:g}", table)
         checkpoint(lr, state, log)
@@ -319,7 +313,7 @@ def profile(lr: Learner, state: TickProgress, feature: str) -> None:
     lr.say(f"trials: the nominal robot's {feature} {p.min():+.3f}..{p.max():+.3f}{fell}")
 
 
-def trials(lr: Learner, state: TickProgress, log: list) -> None:
+def trials(lr: Learner, state: TickProgress, log: list[LogEntry]) -> None:
     """Stage 1: how the reference is played, then one gain at a time, each from its
     candidates, at the trial scale."""
     cfg = lr.cfg
@@ -342,16 +336,15 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
         table = _table(lr, state, getattr(cfg.trials, g.name), walk, limit)
         state.gains[g.name] = kept = best(table, limit)[0]
         log.append(
-            {
-                "stage": "trials",
-                "gain": g.name,
-                "channel": g.channel,
-                "feature": g.feature,
-                "kept": kept,
-                "scale": lr.trial_scale(state),
-                "protocol": protocol or cfg.train_protocol,
-                "table": [{"value": v, **t.summary().to_dict()} for v, t in table],
-            }
+            TrialsEntry(
+                gain=g.name,
+                kept=kept,
+                scale=lr.trial_scale(state),
+                protocol=protocol or cfg.train_protocol,
+                table=[{"value": v, **t.summary().to_dict()} for v, t in table],
+                channel=g.channel,
+                feature=g.feature,
+            )
         )
         say_table(lr, f"trials: {g.feature} -> {g.channel} = {kept:g}", table)
         state.trial += 1
@@ -359,8 +352,10 @@ def trials(lr: Learner, state: TickProgress, log: list) -> None:
     state.stage = "schedule" if cfg.lqr.enabled else "done"
 
 
-def checkpoint(lr: Learner, state: TickProgress, log: list, data: list | None = None) -> None:
+def checkpoint(
+    lr: Learner, state: TickProgress, log: list[LogEntry], data: list | None = None
+) -> None:
     if data is not None:
         lr.rd.write_arrays("data.npz", stack_episodes(data))
-    lr.rd.write_log(log)
+    lr.rd.write_log([e.to_dict() for e in log])
     lr.rd.write_json("checkpoint.json", asdict(state))

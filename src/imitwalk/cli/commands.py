@@ -105,11 +105,8 @@ def _with_command(cfg: RetargetConfig, args: argparse.Namespace) -> RetargetConf
 
 
 def learn(args: argparse.Namespace) -> int:
-    from imitwalk.config import apply_overrides
-    from imitwalk.errors import ConfigError
-    from imitwalk.learning.refchoice import PASSES, learn_clip
-    from imitwalk.retarget import Reference, RetargetConfig
-    from imitwalk.retarget import retarget as do_retarget
+    from imitwalk.learning.refchoice import learn_clip
+    from imitwalk.retarget import Reference
     from imitwalk.runs import RunDir
 
     robot = standing_robot(args)  # every variant, before any work
@@ -117,6 +114,38 @@ def learn(args: argparse.Namespace) -> int:
     if args.variant == "step":
         return _learn_step(args, robot)
     rt_set, learn_set = _split_settings(args.set)
+    cfg, run = _joint_space_learner(args, learn_set)
+    rd = RunDir(args.out)
+    rd.check_writable()
+    resumed = _resumed(args, rd)
+    rcfg = _retarget_config(rt_set, bool(args.reference or resumed))
+    if resumed:
+        ref = Reference.load(rd.file("reference.npz"))
+        progress(f"learn: resuming {rd.path}")
+    elif args.reference:
+        ref = Reference.load(args.reference)
+    else:
+        motion = _motion(args, robot)
+        rcfg = _with_command(rcfg, args)
+        make_reference = _reference_maker(motion, robot, rcfg, args)
+        if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
+            summary, choice = learn_clip(
+                make_reference, robot, cfg, args.out, args.resume, progress
+            )
+            return _learned(summary, args, rd, choice)
+        ref = make_reference()
+    progress(f"learn: {args.variant} variant")
+    summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
+    return _learned(summary, args, rd)
+
+
+def _joint_space_learner(
+    args: argparse.Namespace, learn_set: list[str]
+) -> tuple[Any, Callable[..., LearnSummary]]:
+    """The settings (``--seed``, ``--set``) and learning function of ``--variant``
+    faithful (the paper's learner) or extended (the per-tick learner)."""
+    from imitwalk.config import apply_overrides
+
     if args.variant == "faithful":
         from imitwalk.paper.learnconfig import LearnConfig
         from imitwalk.paper.learner import learn as faithful
@@ -129,8 +158,15 @@ def learn(args: argparse.Namespace) -> int:
 
         cfg = apply_overrides(TickLearnConfig(seed=args.seed), learn_set)
         run = learn_tick
-    rd = RunDir(args.out)
-    rd.check_writable()
+    return cfg, run
+
+
+def _resumed(args: argparse.Namespace, rd: RunDir) -> bool:
+    """True if ``--resume`` goes on with the reference a run chose (``rd``'s own); refuses
+    the commanded-gait flags with a given or resumed reference."""
+    from imitwalk.errors import ConfigError
+    from imitwalk.learning.refchoice import PASSES
+
     flags = [
         f"--{a}" for a in ("turn", "side", "forward", "slope") if getattr(args, a, None) is not None
     ]
@@ -142,34 +178,36 @@ def learn(args: argparse.Namespace) -> int:
             f"{', '.join(flags)} shape a new reference; a given or resumed reference keeps "
             "the command it was built with (retarget again with them)"
         )
+    return resumed
+
+
+def _retarget_config(rt_set: list[str], given: bool) -> RetargetConfig:
+    """The retargeting settings (``--set retarget.KEY=VALUE``), checked even where a
+    ``given`` reference leaves them unused (said on the progress line)."""
+    from imitwalk.config import apply_overrides
+    from imitwalk.retarget import RetargetConfig
+
     rcfg = apply_overrides(RetargetConfig(), rt_set)  # checked even where it is not used
     if rt_set and given:
         unused = ", ".join(f"retarget.{i}" for i in rt_set)
         progress(f"learn: {unused}: not used, the reference is given as it is")
-    if resumed:
-        ref = Reference.load(rd.file("reference.npz"))
-        progress(f"learn: resuming {rd.path}")
-    elif args.reference:
-        ref = Reference.load(args.reference)
-    else:
-        motion = _motion(args, robot)
-        rcfg = _with_command(rcfg, args)
+    return rcfg
 
-        def make_reference(walker: Walker | None = None) -> Reference:
-            progress(f"learn: retargeting {motion.source}")
-            res = do_retarget(motion, robot, rcfg, search_report, walker=walker)
-            progress(f"  cycles: {res.template.meta['cycles_report']}")
-            return _named(res.reference, args)
 
-        if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
-            summary, choice = learn_clip(
-                make_reference, robot, cfg, args.out, args.resume, progress
-            )
-            return _learned(summary, args, rd, choice)
-        ref = make_reference()
-    progress(f"learn: {args.variant} variant")
-    summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
-    return _learned(summary, args, rd)
+def _reference_maker(
+    motion: Motion, robot: Robot, rcfg: RetargetConfig, args: argparse.Namespace
+) -> Callable[..., Reference]:
+    """``make_reference(walker=None)``: ``motion`` retargeted to ``robot`` by ``rcfg``, its
+    search walking candidates under ``walker`` (``None``: open loop)."""
+    from imitwalk.retarget import retarget as do_retarget
+
+    def make_reference(walker: Walker | None = None) -> Reference:
+        progress(f"learn: retargeting {motion.source}")
+        res = do_retarget(motion, robot, rcfg, search_report, walker=walker)
+        progress(f"  cycles: {res.template.meta['cycles_report']}")
+        return _named(res.reference, args)
+
+    return make_reference
 
 
 def _variant(args: argparse.Namespace) -> str:

@@ -99,7 +99,23 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="imitwalk", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"imitwalk {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
+    _add_robot(sub)
+    _add_retarget(sub)
+    _add_playback(sub)
+    _add_learn(sub)
+    _add_evaluate(sub)
+    _add_report(sub)
+    rl_commands.add_parser(sub, PROTOCOLS)
+    export_commands.add_parser(sub)
+    motion_commands.add_parser(sub)
+    sweep_commands.add_parser(sub)
+    navigate_commands.add_parser(sub, PROTOCOLS)
+    _add_demo(sub)
+    return p
 
+
+def _add_robot(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``robot`` group: ``robot info``, ``robot stand`` and ``robot import``."""
     robot = sub.add_parser("robot", help="inspect and test a robot model")
     rsub = robot.add_subparsers(dest="robot_command", required=True)
     info = rsub.add_parser("info", help="joints, limits, mass, height, sensors, rates")
@@ -121,6 +137,9 @@ def build_parser() -> argparse.ArgumentParser:
     imp.add_argument("--json", action="store_true", help="print JSON")
     imp.set_defaults(func=robot_commands.robot_import)
 
+
+def _add_retarget(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``retarget`` subcommand's arguments."""
     rt = sub.add_parser("retarget", help="mocap -> robot joint trajectory (.npz)")
     _mocap_args(rt)
     _robot_args(rt, positional=False)
@@ -141,6 +160,9 @@ def build_parser() -> argparse.ArgumentParser:
     rt.add_argument("--json", action="store_true", help="print JSON")
     rt.set_defaults(func=commands.retarget)
 
+
+def _add_playback(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``playback`` subcommand's arguments."""
     pb = sub.add_parser("playback", help="play a reference open loop on nominal + perturbed robots")
     pb.add_argument("reference", help="a .npz written by retarget")
     pb.add_argument("--scale", type=float, default=0.5, help="stride scale (0.5)")
@@ -152,6 +174,10 @@ def build_parser() -> argparse.ArgumentParser:
     _engine_arg(pb, "mujoco", "mujoco")
     pb.add_argument("--json", action="store_true", help="print JSON")
     pb.set_defaults(func=commands.playback)
+
+
+def _add_learn(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``learn`` subcommand's arguments."""
     ln = sub.add_parser(
         "learn",
         help="learn to walk a mocap clip: the clip's style on the robot's legs, a stepping "
@@ -186,6 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
     ln.add_argument("--json", action="store_true", help="print JSON")
     ln.set_defaults(func=commands.learn)
 
+
+def _add_evaluate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``evaluate`` subcommand's arguments."""
     ev = sub.add_parser(
         "evaluate", help="every controller of a run, side by side, on a protocol's robots"
     )
@@ -222,6 +251,10 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--workers", type=int, default=None, help="parallel processes")
     ev.add_argument("--json", action="store_true", help="print JSON")
     ev.set_defaults(func=judge_commands.evaluate)
+
+
+def _add_report(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``report`` subcommand's arguments."""
     rp = sub.add_parser("report", help="write RUN_DIR/report.html (figures, film strips, video)")
     rp.add_argument("run_dir", help="a run folder written by learn")
     rp.add_argument("--seconds", type=float, default=10.0, help="length of the replays (10)")
@@ -230,17 +263,13 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--json", action="store_true", help="print JSON")
     rp.set_defaults(func=judge_commands.report)
 
-    rl_commands.add_parser(sub, PROTOCOLS)
-    export_commands.add_parser(sub)
-    motion_commands.add_parser(sub)
-    sweep_commands.add_parser(sub)
-    navigate_commands.add_parser(sub, PROTOCOLS)
 
+def _add_demo(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """The ``demo`` subcommand's arguments."""
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")
     dm.add_argument("--json", action="store_true", help="print JSON")
     dm.set_defaults(func=commands.demo)
-    return p
 
 
 def _one_line_warning(

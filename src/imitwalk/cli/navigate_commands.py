@@ -11,10 +11,13 @@ from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
 
 if TYPE_CHECKING:
+    from imitwalk.judge.replay import LoadedRun
+    from imitwalk.navigate.course import Course
     from imitwalk.navigate.trial import NavJob, NavResult
     from imitwalk.robots import Robot
     from imitwalk.runs import RunDir
     from imitwalk.sim.fix import PositionFix
+    from imitwalk.sim.protocol import Protocol
 
 __all__ = ["add_parser", "navigate"]
 
@@ -69,26 +72,56 @@ def _video(job: NavJob, result: NavResult, path: Path) -> Path:
 
 
 def navigate(args: argparse.Namespace) -> int:
-    import numpy as np
-
     from imitwalk.errors import ConfigError
-    from imitwalk.evidence.navplot import course_figure
-    from imitwalk.evidence.plots import png_bytes
     from imitwalk.fileio import atomic_write
-    from imitwalk.judge.replay import load_run
-    from imitwalk.navigate.course import DEFAULT_COURSE, Course, parse_waypoints
-    from imitwalk.navigate.trial import NavJob, run_nav_job
+    from imitwalk.navigate.trial import run_nav_job
     from imitwalk.parallel import run_parallel
-    from imitwalk.runs import RunDir
-    from imitwalk.sim.protocol import load_protocol
 
-    wp = np.array(DEFAULT_COURSE) if args.waypoints is None else parse_waypoints(args.waypoints)
-    course = Course(wp, args.reach)
+    course = _course(args)
     if args.seeds < 1 or not args.seconds > 0:
         raise ConfigError(
             f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
         )
     fix = _fix(args)
+    rd, lr, robot = _stepping_run(args)
+    out = _out_dir(args, rd)
+    protocol, jobs = _nav_jobs(args, lr, robot, course, fix)
+    what = "dead reckoning" if fix is None else f"a fix at {fix.rate_hz:g} Hz, {fix.sigma_m:g} m"
+    progress(
+        f"navigate: {len(course.waypoints)} waypoints, {args.seeds} robots of "
+        f"{protocol.name}, at most {args.seconds:g} s each, by {what}"
+    )
+    results = run_parallel(run_nav_job, jobs, workers=args.workers)
+    summary = _summary(rd, robot, protocol, course, fix, results)
+    _write_plot(out, rd, protocol, course, results)
+    if args.video:
+        summary["video"] = str(_video(jobs[0], results[0], out / "video.mp4"))
+    summary["plot"] = str(out / "path.png")
+    text = json.dumps(summary, indent=2)
+    atomic_write(out / "navigate.json", lambda tmp: tmp.write_text(text))
+    done = summary["finished"]
+    progress(f"navigate: {done}/{len(results)} finished, {summary['fell']} fell; -> {out}")
+    emit(summary, args.json)
+    return 0
+
+
+def _course(args: argparse.Namespace) -> Course:
+    """The course to walk: ``--waypoints`` (default :data:`DEFAULT_COURSE`), ``(K, 2)`` [m],
+    and ``--reach`` [m]."""
+    import numpy as np
+
+    from imitwalk.navigate.course import DEFAULT_COURSE, Course, parse_waypoints
+
+    wp = np.array(DEFAULT_COURSE) if args.waypoints is None else parse_waypoints(args.waypoints)
+    return Course(wp, args.reach)
+
+
+def _stepping_run(args: argparse.Namespace) -> tuple[RunDir, LoadedRun, Robot]:
+    """The run folder, its loaded run (a stepping one, else refused) and its robot."""
+    from imitwalk.errors import ConfigError
+    from imitwalk.judge.replay import load_run
+    from imitwalk.runs import RunDir
+
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     lr = load_run(rd.path)
@@ -96,10 +129,31 @@ def navigate(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"{rd.path} is a {lr.learner!r} run; navigate steers the stepping gait (learner: step)"
         )
-    robot = _robot(args, rd, cfg)
+    return rd, lr, _robot(args, rd, cfg)
+
+
+def _out_dir(args: argparse.Namespace, rd: RunDir) -> Path:
+    """The folder to write to (``--out``, default ``RUN/navigate``); refuses a file."""
+    from imitwalk.errors import ConfigError
+
     out = Path(args.out) if args.out else Path(rd.path) / "navigate"
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out}: exists and is not a folder")
+    return out
+
+
+def _nav_jobs(
+    args: argparse.Namespace,
+    lr: LoadedRun,
+    robot: Robot,
+    course: Course,
+    fix: PositionFix | None,
+) -> tuple[Protocol, list[NavJob]]:
+    """The protocol and one job per robot ``0 … --seeds − 1`` (the first recorded for
+    ``--video``), each walking the run's learned gains for at most ``--seconds`` [s]."""
+    from imitwalk.navigate.trial import NavJob
+    from imitwalk.sim.protocol import load_protocol
+
     gait = lr.step_gait
     assert lr.step_gains is not None  # a stepping run has its gains
     style, gains = gait.at_scale(lr.scale), lr.step_gains["learned"]
@@ -119,44 +173,57 @@ def navigate(args: argparse.Namespace) -> int:
         )
         for seed in range(args.seeds)
     ]
-    what = "dead reckoning" if fix is None else f"a fix at {fix.rate_hz:g} Hz, {fix.sigma_m:g} m"
-    progress(
-        f"navigate: {len(wp)} waypoints, {args.seeds} robots of {protocol.name}, "
-        f"at most {args.seconds:g} s each, by {what}"
-    )
-    results = run_parallel(run_nav_job, jobs, workers=args.workers)
+    return protocol, jobs
+
+
+def _summary(
+    rd: RunDir,
+    robot: Robot,
+    protocol: Protocol,
+    course: Course,
+    fix: PositionFix | None,
+    results: list[NavResult],
+) -> dict:
+    """``navigate.json``'s content: the settings, the counts and times [s], distances [m]
+    and every robot's result (without the plot and video paths)."""
+    import numpy as np
+
     done = [r for r in results if r.finished]
-    summary = {
+    finish_s = [r.finish_s for r in done if r.finish_s is not None]  # all of them: finished
+    return {
         "run": str(rd.path),
         "robot": robot.name,
         "protocol": protocol.name,
-        "waypoints": wp.tolist(),
+        "waypoints": course.waypoints.tolist(),
         "reach_m": course.reach,
         "fix": None if fix is None else {"rate_hz": fix.rate_hz, "sigma_m": fix.sigma_m},
         "robots": len(results),
         "finished": len(done),
         "fell": sum(r.fell for r in results),
-        "finish_s_mean": float(np.mean([r.finish_s for r in done])) if done else None,
-        "finish_s_max": float(max(r.finish_s for r in done)) if done else None,
+        "finish_s_mean": float(np.mean(finish_s)) if done else None,
+        "finish_s_max": float(max(finish_s)) if done else None,
         "closest_m_max": float(max(max(r.closest_m) for r in results)),
         "odometry_error_m_mean": float(np.mean([r.odometry_error_m for r in results])),
         "results": [r.to_dict() for r in results],
     }
+
+
+def _write_plot(
+    out: Path, rd: RunDir, protocol: Protocol, course: Course, results: list[NavResult]
+) -> None:
+    """Draw every robot's path over the course into ``out/path.png``."""
+    from imitwalk.evidence.navplot import course_figure
+    from imitwalk.evidence.plots import png_bytes
+    from imitwalk.fileio import atomic_write
+
+    done = sum(r.finished for r in results)
     title = (
-        f"{rd.path}: {len(done)}/{len(results)} robots of {protocol.name} reached all "
-        f"{len(wp)} waypoints"
+        f"{rd.path}: {done}/{len(results)} robots of {protocol.name} reached all "
+        f"{len(course.waypoints)} waypoints"
     )
     fig = course_figure(course.waypoints, course.reach, results, title)
     png = png_bytes(fig)
     atomic_write(out / "path.png", lambda tmp: tmp.write_bytes(png))
-    if args.video:
-        summary["video"] = str(_video(jobs[0], results[0], out / "video.mp4"))
-    summary["plot"] = str(out / "path.png")
-    text = json.dumps(summary, indent=2)
-    atomic_write(out / "navigate.json", lambda tmp: tmp.write_text(text))
-    progress(f"navigate: {len(done)}/{len(results)} finished, {summary['fell']} fell; -> {out}")
-    emit(summary, args.json)
-    return 0
 
 
 def add_parser(

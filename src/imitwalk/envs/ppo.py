@@ -45,6 +45,8 @@ from imitwalk.runs import LearnSummary, RunDir
 if TYPE_CHECKING:
     import gymnasium as gym
     from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.vec_env import VecEnv
 
     from imitwalk.rl.actor import ActorSpec
 
@@ -170,8 +172,6 @@ def train(
             ``resume``) or nothing to resume.
     """
     import torch
-    from stable_baselines3 import PPO
-    from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
     rd = RunDir(out)
@@ -184,81 +184,152 @@ def train(
         )
     dt = setup.dt
     total = int(round(cfg.budget / dt))
-    wall0 = time.perf_counter()
-    before = rd.read_json("checkpoint.json") if resume and rd.exists("checkpoint.json") else {}
-    wall_before = float(before.get("wall_seconds", 0.0))
+    wall = _wall_clock(rd, resume)
     kwargs = walk.to_dict()
     kwargs["weights"] = walk.weights
     makers = [_make_env(kwargs)] * cfg.envs
     venv = SubprocVecEnv(makers) if cfg.envs > 1 else DummyVecEnv(makers)
     venv.seed(cfg.seed)
     torch.manual_seed(cfg.seed)
-    if resume:
-        model = PPO.load(rd.file("ppo.zip"), env=venv, device="cpu")
-        done = int(model.num_timesteps)  # log lines past the saved model are redone
-        rd.write_log([e for e in rd.read_log() if int(e.get("timesteps", 0)) <= done])
-    else:
-        hidden = list(cfg.hidden)
-        model = PPO(
-            "MlpPolicy",
-            venv,
-            n_steps=cfg.n_steps,
-            batch_size=cfg.batch_size,
-            n_epochs=cfg.epochs,
-            learning_rate=cfg.learning_rate,
-            gamma=cfg.gamma,
-            gae_lambda=cfg.gae_lambda,
-            clip_range=cfg.clip_range,
-            ent_coef=cfg.ent_coef,
-            policy_kwargs={
-                "net_arch": {"pi": hidden, "vf": hidden},
-                "log_std_init": (
-                    LOG_STD_INIT[walk.action] if cfg.log_std_init is None else cfg.log_std_init
-                ),
-            },
-            seed=cfg.seed,
-            device="cpu",
-            verbose=0,
-        )
+    model = _model(rd, venv, walk, cfg, resume)
+    every = max(int(round(cfg.snapshot_every / dt)), 1)
+    steps = int(model.num_timesteps)
+    checkpoint = _Checkpoints(rd, cfg.budget, dt, every, wall, progress, steps, steps // every)
+    _learn(model, venv, total, resume, checkpoint)
+    return _finish(rd, walk, cfg, float(model.num_timesteps) * dt, wall)
+
+
+def _wall_clock(rd: RunDir, resume: bool) -> Callable[[], float]:
+    """``wall()``: the run's wall-clock seconds of learning [s], from now on plus, when
+    resuming, those of ``checkpoint.json``."""
+    wall0 = time.perf_counter()
+    before = rd.read_json("checkpoint.json") if resume and rd.exists("checkpoint.json") else {}
+    wall_before = float(before.get("wall_seconds", 0.0))
 
     def wall() -> float:
         return wall_before + time.perf_counter() - wall0
 
-    every = max(int(round(cfg.snapshot_every / dt)), 1)
+    return wall
 
-    state = {"snapshots": int(model.num_timesteps) // every, "saved": int(model.num_timesteps)}
 
-    def checkpoint(m: PPO) -> None:
+def _model(rd: RunDir, venv: VecEnv, walk: WalkConfig, cfg: PPOConfig, resume: bool) -> PPO:
+    """The PPO model on ``venv``: ``ppo.zip``'s when resuming (the log cut back to its
+    step count), else a new one with ``cfg``'s settings."""
+    from stable_baselines3 import PPO
+
+    if resume:
+        model = PPO.load(rd.file("ppo.zip"), env=venv, device="cpu")
+        done = int(model.num_timesteps)  # log lines past the saved model are redone
+        rd.write_log([e for e in rd.read_log() if int(e.get("timesteps", 0)) <= done])
+        return model
+    hidden = list(cfg.hidden)
+    return PPO(
+        "MlpPolicy",
+        venv,
+        n_steps=cfg.n_steps,
+        batch_size=cfg.batch_size,
+        n_epochs=cfg.epochs,
+        learning_rate=cfg.learning_rate,
+        gamma=cfg.gamma,
+        gae_lambda=cfg.gae_lambda,
+        clip_range=cfg.clip_range,
+        ent_coef=cfg.ent_coef,
+        policy_kwargs={
+            "net_arch": {"pi": hidden, "vf": hidden},
+            "log_std_init": (
+                LOG_STD_INIT[walk.action] if cfg.log_std_init is None else cfg.log_std_init
+            ),
+        },
+        seed=cfg.seed,
+        device="cpu",
+        verbose=0,
+    )
+
+
+def _learn(model: PPO, venv: VecEnv, total: int, resume: bool, checkpoint: _Checkpoints) -> None:
+    """PPO up to ``total`` ticks in all, ``checkpoint`` after every update and at the end;
+    closes ``venv`` whatever happens."""
+    try:
+        remaining = max(total - int(model.num_timesteps), 0)
+        if remaining:
+            model.learn(
+                total_timesteps=remaining,
+                callback=_checkpoint_callback(checkpoint),
+                reset_num_timesteps=not resume,
+            )
+        checkpoint(model)
+    finally:
+        venv.close()
+
+
+@dataclass
+class _Checkpoints:
+    """Saves a run's PPO model, its policy (and a snapshot every ``every`` ticks) and a
+    log line each time it is called on a model that has stepped since.
+
+    Attributes:
+        rd: the run folder; budget: the run's simulated seconds [s]; dt: one tick [s];
+        every: ticks between snapshots; wall: the run's wall-clock seconds so far [s];
+        progress: optional ``callback(line)``; saved: the step count last saved;
+        snapshots: ``saved // every`` when the last snapshot was kept.
+    """
+
+    rd: RunDir
+    budget: float
+    dt: float
+    every: int
+    wall: Callable[[], float]
+    progress: Callable[[str], None] | None
+    saved: int
+    snapshots: int
+
+    def __call__(self, m: PPO) -> None:
         """Save the model, its policy and a log line: after each update, so that the
         model, the policy and the step count always agree."""
         steps = int(m.num_timesteps)
-        if steps == state["saved"]:
+        if steps == self.saved:
             return
-        state["saved"] = steps
+        self.saved = steps
         # SB3 declares the buffer optional; learn() has made it by the first callback
         eps = list(m.ep_info_buffer)  # type: ignore[arg-type]
-        line = {
-            "timesteps": steps,
-            "sim_seconds": steps * dt,
-            "episode_return": float(np.mean([e["r"] for e in eps])) if eps else None,
-            "episode_seconds": float(np.mean([e["l"] for e in eps])) * dt if eps else None,
-            "wall_seconds": wall(),
-        }
-        atomic_write(rd.file("ppo.zip"), lambda tmp: _save_model(m, tmp))
-        net = from_sb3(m)
-        net.save(rd.file("policy.npz"))
-        if steps // every > state["snapshots"]:
-            state["snapshots"] = steps // every
-            net.save(rd.file("snapshots") / f"policy_{steps * dt:.0f}.npz")
-        rd.write_log([*rd.read_log(), line])
-        rd.write_json("checkpoint.json", {"timesteps": steps, "wall_seconds": wall()})
-        if progress is not None:
+        line = self._log_line(steps, eps)
+        self._save(m, steps)
+        self.rd.write_log([*self.rd.read_log(), line])
+        self.rd.write_json("checkpoint.json", {"timesteps": steps, "wall_seconds": self.wall()})
+        if self.progress is not None:
             ret = "-" if line["episode_return"] is None else f"{line['episode_return']:.1f}"
             length = "-" if not eps else f"{line['episode_seconds']:.1f} s"
-            progress(
-                f"  PPO {steps * dt:,.0f}/{cfg.budget:,.0f} sim s: episode return {ret}, "
-                f"episodes last {length} ({wall():.0f} s wall)"
+            self.progress(
+                f"  PPO {steps * self.dt:,.0f}/{self.budget:,.0f} sim s: episode return {ret}, "
+                f"episodes last {length} ({self.wall():.0f} s wall)"
             )
+
+    def _log_line(self, steps: int, eps: list[dict]) -> dict:
+        """``log.jsonl``'s line after ``steps`` ticks: simulated and wall seconds [s], and
+        the mean return and length [s] of the episodes in ``eps`` (SB3's ``r``, ``l``)."""
+        return {
+            "timesteps": steps,
+            "sim_seconds": steps * self.dt,
+            "episode_return": float(np.mean([e["r"] for e in eps])) if eps else None,
+            "episode_seconds": float(np.mean([e["l"] for e in eps])) * self.dt if eps else None,
+            "wall_seconds": self.wall(),
+        }
+
+    def _save(self, m: PPO, steps: int) -> None:
+        """Write ``ppo.zip`` and ``policy.npz``, and a snapshot once ``every`` ticks more
+        have passed."""
+        atomic_write(self.rd.file("ppo.zip"), lambda tmp: _save_model(m, tmp))
+        net = from_sb3(m)
+        net.save(self.rd.file("policy.npz"))
+        if steps // self.every > self.snapshots:
+            self.snapshots = steps // self.every
+            net.save(self.rd.file("snapshots") / f"policy_{steps * self.dt:.0f}.npz")
+
+
+def _checkpoint_callback(checkpoint: _Checkpoints) -> BaseCallback:
+    """An SB3 callback that calls ``checkpoint`` at each rollout's start (the last
+    rollout's update done)."""
+    from stable_baselines3.common.callbacks import BaseCallback
 
     class Checkpoint(BaseCallback):
         def _on_step(self) -> bool:
@@ -267,22 +338,20 @@ def train(
         def _on_rollout_start(self) -> None:  # the last rollout's update is done
             checkpoint(self.model)  # type: ignore[arg-type]  # SB3 says BaseAlgorithm: this PPO
 
-    try:
-        remaining = max(total - int(model.num_timesteps), 0)
-        if remaining:
-            model.learn(
-                total_timesteps=remaining, callback=Checkpoint(), reset_num_timesteps=not resume
-            )
-        checkpoint(model)
-    finally:
-        venv.close()
+    return Checkpoint()
+
+
+def _finish(
+    rd: RunDir, walk: WalkConfig, cfg: PPOConfig, sim_seconds: float, wall: Callable[[], float]
+) -> LearnSummary:
+    """Write ``metrics.json``: the run's summary after ``sim_seconds`` of experience [s]."""
     log = rd.read_log()
     summary = LearnSummary(
         learner="rl",
         scale_reached=1.0,
         scales_passed=[1.0],
         iterations=len(log),
-        sim_seconds_used_for_learning=float(model.num_timesteps) * dt,
+        sim_seconds_used_for_learning=sim_seconds,
         wall_seconds_for_learning=wall(),
         config={"rl": cfg.to_dict(), "env": walk.to_dict()},
     )

@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.projections.polar import PolarAxes
 from matplotlib.ticker import MaxNLocator
 
+from imitwalk.balance.ticklog import ScheduleEntry, entry_from_dict
 from imitwalk.evidence.plots import _figure
 from imitwalk.judge.records import PushVerdict
 
@@ -119,24 +120,23 @@ def torso_paths(
 
 
 def tick_curves(log: Sequence[dict]) -> Figure:
-    """A per-tick run's learning: each schedule iteration's falls, measured eq.-6 cost Γ
-    and its model's held-out one-tick error over "nothing changes"; dotted lines mark
-    where the scale changes."""
-    sched = [e for e in log if e.get("stage") == "schedule"]
+    """A per-tick run's learning (its ``log.jsonl`` lines): each schedule iteration's falls,
+    measured eq.-6 cost Γ and its model's held-out one-tick error over "nothing changes";
+    dotted lines mark where the scale changes."""
+    entries = [entry_from_dict(line) for line in log]
+    sched = [e for e in entries if isinstance(e, ScheduleEntry)]
     fig = _figure(8.0, 6.0)
     axes = fig.subplots(3, 1, sharex=True)
     if not sched:
         axes[0].set_title("no schedule iterations logged (the model-based law was off)")
         return fig
     it = np.arange(len(sched))
-    axes[0].bar(it, [e["falls"] for e in sched], color="tab:red", label="falls")
-    axes[0].plot(it, [e["robots"] for e in sched], "k_", ms=14, label="robots")
+    axes[0].bar(it, [e.walks.falls for e in sched], color="tab:red", label="falls")
+    axes[0].plot(it, [e.walks.robots for e in sched], "k_", ms=14, label="robots")
     axes[0].set_ylabel("falls")
-    axes[1].plot(it, [e["cost"] for e in sched], "o-", label="measured Γ")
+    axes[1].plot(it, [e.walks.cost for e in sched], "o-", label="measured Γ")
     axes[1].set_ylabel("cost Γ(ω)")
-    ratio = [
-        np.nan if not e.get("held_out") else e["held_out"]["ratio_to_persistence"] for e in sched
-    ]
+    ratio = [np.nan if not e.held_out else e.held_out["ratio_to_persistence"] for e in sched]
     axes[2].plot(it, ratio, "o-", label="model / persistence")
     axes[2].axhline(1.0, color="k", ls="--", lw=0.8, label='"nothing changes"')
     axes[2].set_ylabel("held-out MSE ratio")
@@ -144,7 +144,7 @@ def tick_curves(log: Sequence[dict]) -> Figure:
     axes[2].xaxis.set_major_locator(MaxNLocator(integer=True))
     for ax in axes:
         ax.legend(fontsize=8)
-    scales = [e["scale"] for e in sched]
+    scales = [e.scale for e in sched]
     for i, s in enumerate(scales):
         if i == 0 or s != scales[i - 1]:
             for a in axes:

@@ -180,42 +180,80 @@ def _sections(
     ticks: np.ndarray,
     kick: tuple[Figure, str],
 ) -> str:
+    """The report's body: every section's HTML, in page order."""
     scale, log, m = rp.scale, rd.read_log(), lg.metrics
     passed = [float(p) for p in m.scales_passed]
     at_final = bool(passed) and abs(lg.scale - scale) < 1e-9
-    evr = gait.subspace.explained_variance_ratio_
-    gyro = curves.gyro_traces(
+    gyro = _gyro(rp)
+    learning = curves.tick_curves(log) if lg.laws is not None else curves.learning_curves(log)
+    actions = rp.actions if (at_final and len(rp.actions)) else None
+    fig7 = plots.fig7_schedule(gait, passed, actions, lg.scale)
+    fig6 = _fig6(gait, rp, lg.scale)
+    sections = [
+        *_outcome_sections(rd, rp, video, fig8, kick),
+        *_learning_sections(lg, rp, learning, gyro, passed),
+        *_paper_sections(gait, scale, poses, ticks, fig6, fig7),
+        (
+            "Configuration",
+            "<details><summary>config.json</summary><pre>"
+            + html.escape(json.dumps(config, indent=2))
+            + "</pre></details>",
+        ),
+    ]
+    return "".join(section(t, b) for t, b in sections)
+
+
+def _gyro(rp: media.Replays) -> Figure:
+    """Both replays' torso gyro traces [rad/s] up to just after a fall."""
+    return curves.gyro_traces(
         media.gyro_until_fall(rp.before),
         media.gyro_until_fall(rp.after),
         rp.before.control_dt,
         fall_times=(rp.before.fall_time, rp.after.fall_time),
     )
-    learning = curves.tick_curves(log) if lg.laws is not None else curves.learning_curves(log)
-    actions = rp.actions if (at_final and len(rp.actions)) else None
-    fig7 = plots.fig7_schedule(gait, passed, actions, lg.scale)
-    fig6 = (
-        plots.fig6_optimized(gait, scale, rp.actions, rp.postures(gait))
-        if len(rp.actions)
-        else plots.fig7_schedule(gait, [], None, lg.scale)
-    )
-    fig6_caption = (
-        "The actions (φ, r, h) the learned controller executed in the replay above (red, up "
-        "to its fall, if it fell); in green, the joint targets it actually sent, projected "
-        "into the subspace."
-        if len(rp.actions)
-        else "A per-tick run acts on the legs' joints, beside the paper's (φ, r, h): "
+
+
+def _fig6(gait: GaitModel, rp: media.Replays, reached: float) -> tuple[Figure, str]:
+    """Fig. 6 and its caption: the learned actions (φ, r, h) of the replay at
+    ``rp.scale``; for a per-tick run, which has none, the loop at the ``reached`` scale."""
+    if len(rp.actions):
+        fig = plots.fig6_optimized(gait, rp.scale, rp.actions, rp.postures(gait))
+        return fig, (
+            "The actions (φ, r, h) the learned controller executed in the replay above (red, "
+            "up to its fall, if it fell); in green, the joint targets it actually sent, "
+            "projected into the subspace."
+        )
+    return plots.fig7_schedule(gait, [], None, reached), (
+        "A per-tick run acts on the legs' joints, beside the paper's (φ, r, h): "
         "its actions have no place in this figure; the loop is drawn at the scale reached."
     )
-    sections = [
+
+
+def _outcome_sections(
+    rd: RunDir, rp: media.Replays, video: str, fig8: str, kick: tuple[Figure, str]
+) -> list[tuple[str, str]]:
+    """(title, HTML) of the outcome: the before/after video, Fig. 8, the evaluations and
+    robustness."""
+    return [
         (
             "Before and after",
             video + f"<p>Nominal robot, from standing, at the scale reached "
-            f"({scale:g}). Open loop: {media.outcome(rp.before)}. "
+            f"({rp.scale:g}). Open loop: {media.outcome(rp.before)}. "
             f"Learned: {media.outcome(rp.after)}.</p>",
         ),
         ("Fig. 8: learning to walk through imitation", fig8),
         ("Evaluation", evaluations(rd)),
         ("Robustness", robustness(rd, kick)),
+    ]
+
+
+def _learning_sections(
+    lg: LoadedRun, rp: media.Replays, learning: Figure, gyro: Figure, passed: list[float]
+) -> list[tuple[str, str]]:
+    """(title, HTML) of the learning curves, the torso paths and the gyro traces;
+    ``passed``: the scales the schedule passed."""
+    m = lg.metrics
+    return [
         (
             "Learning",
             figure(
@@ -241,6 +279,21 @@ def _sections(
                 "after a fall (dashed: the fall); eq. 6 weighs their squares.",
             ),
         ),
+    ]
+
+
+def _paper_sections(
+    gait: GaitModel,
+    scale: float,
+    poses: list[np.ndarray],
+    ticks: np.ndarray,
+    fig6: tuple[Figure, str],
+    fig7: Figure,
+) -> list[tuple[str, str]]:
+    """(title, HTML) of the paper's Figs. 3, 4, 6 and 7 at ``scale``; ``poses``: the
+    robot rendered at ``ticks`` of the loop."""
+    evr = gait.subspace.explained_variance_ratio_
+    return [
         (
             "Fig. 3: posture subspace",
             figure(
@@ -257,7 +310,7 @@ def _sections(
                 "The frame of eq. 1 and g(φ) of eq. 2.",
             ),
         ),
-        ("Fig. 6: optimised pattern", figure(img(fig6, "Fig. 6"), fig6_caption)),
+        ("Fig. 6: optimised pattern", figure(img(fig6[0], "Fig. 6"), fig6[1])),
         (
             "Fig. 7: motion pattern scaling",
             figure(
@@ -266,11 +319,4 @@ def _sections(
                 "controller executed above (a faithful run's).",
             ),
         ),
-        (
-            "Configuration",
-            "<details><summary>config.json</summary><pre>"
-            + html.escape(json.dumps(config, indent=2))
-            + "</pre></details>",
-        ),
     ]
-    return "".join(section(t, b) for t, b in sections)

@@ -12,7 +12,7 @@ the controller, so the comparison is paired.
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +33,7 @@ from imitwalk.parallel import run_parallel
 from imitwalk.robots import Robot
 from imitwalk.runs import RunDir
 from imitwalk.sim.metrics import WalkMetrics, walk_metrics
-from imitwalk.sim.protocol import Protocol
+from imitwalk.sim.protocol import Protocol, RobotDraw
 from imitwalk.sim.types import SimOptions
 
 __all__ = ["JudgeJob", "RobotWalk", "judge_protocol", "run_controller"]
@@ -178,16 +178,61 @@ def judge_protocol(
     if first < 0:
         raise ConfigError(f"first robot {first}: valid robots are 0 and up")
     loaded = _loaded(str(run_dir))
+    controllers = _checked_controllers(loaded, controllers)
+    draws = [protocol.draw(first + s, robot, seconds=seconds) for s in range(seeds)]
+    twin = {c: loaded.twin(c) for c in controllers}
+    jobs = _jobs(str(run_dir), robot, protocol, draws, twin, seconds, scale)
+    stop = _stop(controllers, most_falls)
+    res = run_parallel(run_controller, jobs, workers, stop=stop)
+    jobs = jobs[: len(res)]  # the robots walked
+    by = {
+        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
+        for c in controllers
+    }
+    saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(controllers)
+    if explain:
+        why = explain_falls(run_controller, jobs, res, protocol, robot, seconds, workers)
+        for c in controllers:
+            saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
+    return ProtocolVerdict(
+        protocol=ProtocolId(protocol.name, protocol.version, protocol.path),
+        settings=JudgeSettings(
+            seeds=seeds,
+            first=first,
+            seconds=seconds,
+            engine=protocol.engine,
+            scale=scale if scale is not None else loaded.metrics.scale_reached,
+            controllers=tuple(controllers),
+        ),
+        controllers={c: _side(runs, protocol.factors, saved[c]) for c, runs in by.items()},
+        comparison=_comparison(by, controllers),
+    )
+
+
+def _checked_controllers(loaded: LoadedRun, controllers: tuple[str, ...] | None) -> tuple[str, ...]:
+    """``controllers`` (``None``: every one ``loaded`` can build); refuses one it cannot."""
     valid = loaded.controllers()
     controllers = valid if controllers is None else tuple(controllers)
     for c in controllers:
         if c not in valid:
             raise unknown_name("controller", c, valid, ConfigError)
-    draws = [protocol.draw(first + s, robot, seconds=seconds) for s in range(seeds)]
-    twin = {c: loaded.twin(c) for c in controllers}
-    jobs = [
+    return controllers
+
+
+def _jobs(
+    run_dir: str,
+    robot: Robot,
+    protocol: Protocol,
+    draws: list[RobotDraw],
+    twin: dict[str, str],
+    seconds: float,
+    scale: float | None,
+) -> list[JudgeJob]:
+    """One job per distinct controller (``twin``: each one's exact copy walked in its
+    place) and drawn robot, in that order, each walking ``seconds`` [s] at ``scale``."""
+    return [
         JudgeJob(
-            str(run_dir),
+            run_dir,
             robot,
             c,
             d.seed,
@@ -200,41 +245,28 @@ def judge_protocol(
         for c in dict.fromkeys(twin.values())  # exact copies walk once
         for d in draws
     ]
-    stop = None
-    if most_falls is not None:
-        if len(controllers) != 1:
-            raise ConfigError(f"most_falls needs one controller, not {len(controllers)}")
-        stop = lambda done: sum(r.metrics.fell for r in done) > most_falls  # noqa: E731
-    res = run_parallel(run_controller, jobs, workers, stop=stop)
-    jobs = jobs[: len(res)]  # the robots walked
-    by = {
-        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
-        for c in controllers
-    }
-    saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(controllers)
-    if explain:
-        why = explain_falls(run_controller, jobs, res, protocol, robot, seconds, workers)
-        for c in controllers:
-            saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
+
+
+def _stop(
+    controllers: tuple[str, ...], most_falls: int | None
+) -> Callable[[list[RobotWalk]], bool] | None:
+    """``stop(done)`` for :func:`~imitwalk.parallel.run_parallel`: true once more than
+    ``most_falls`` robots fell (one controller only); ``None``: walk every robot."""
+    if most_falls is None:
+        return None
+    if len(controllers) != 1:
+        raise ConfigError(f"most_falls needs one controller, not {len(controllers)}")
+    return lambda done: sum(r.metrics.fell for r in done) > most_falls
+
+
+def _comparison(by: dict[str, list[RobotWalk]], controllers: tuple[str, ...]) -> dict:
+    """Each controller's falls against open loop's on the same robots, paired (McNemar);
+    a stepping run, which has no open loop, against its shipped gains, ``default``."""
     comparison = {}
-    # each controller against open loop's falls on the same robots (a stepping run, which
-    # has none, against its shipped gains, ``default``)
     against = OPEN_LOOP if OPEN_LOOP in by else ("default" if "default" in by else None)
     if against is not None:
         base = [r.metrics.fell for r in by[against]]
         for c in controllers:
             if c != against:
                 comparison[c] = compare_falls([r.metrics.fell for r in by[c]], base)
-    return ProtocolVerdict(
-        protocol=ProtocolId(protocol.name, protocol.version, protocol.path),
-        settings=JudgeSettings(
-            seeds=seeds,
-            first=first,
-            seconds=seconds,
-            engine=protocol.engine,
-            scale=scale if scale is not None else loaded.metrics.scale_reached,
-            controllers=tuple(controllers),
-        ),
-        controllers={c: _side(runs, protocol.factors, saved[c]) for c, runs in by.items()},
-        comparison=comparison,
-    )
+    return comparison

@@ -55,8 +55,10 @@ from imitwalk.sim.metrics import WalkMetrics
 from imitwalk.sim.types import SimOptions
 
 if TYPE_CHECKING:
+    from imitwalk.balance.tickconfig import ChoiceConfig
     from imitwalk.retarget.reference import Reference
     from imitwalk.retarget.search import Walker
+    from imitwalk.sim.protocol import Protocol
 
 __all__ = [
     "PASSES",
@@ -279,7 +281,6 @@ def _judge(
     """Each pass's learned controller on the choice's training robots; ``searched``: each
     pass's reference search's simulated seconds [s]; ``same``: the passes that share an
     earlier pass's gait, and whose."""
-    from imitwalk.judge.verdict import judge_protocol
     from imitwalk.sim.protocol import load_protocol
 
     c = cfg.choice
@@ -288,59 +289,91 @@ def _judge(
     out: list[PassVerdict] = []
     for name in PASSES:
         if name in same:  # its twin's verdict, walked once
-            twin = next(v for v in out if v.name == same[name])
-            out.append(
-                replace(
-                    twin,
-                    name=name,
-                    learn_sim_seconds=0.0,
-                    learn_wall_seconds=0.0,
-                    search_sim_seconds=searched[name],
-                    same_as=twin.name,
-                )
-            )
-            say(f"  {name}: {twin.name}'s gait, {twin.name}'s verdict")
+            out.append(_shared_verdict(out, name, same[name], searched[name], say))
             continue
-        path, s = root.file(name), summaries[name]
-        # at pass 1's scale, a pass that has fallen more often can no longer be kept
-        tie = out and s.scale_reached == out[0].scale
-        v = judge_protocol(
-            path,
-            robot,
-            protocol,
-            c.robots,
-            c.seconds,
-            ("learned",),
-            workers=cfg.workers,
-            first=c.first,
-            most_falls=out[0].falls if tie else None,
-        )
-        cv = v.controllers["learned"]
-        walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
-        out.append(
-            PassVerdict(
-                name,
-                float(s.scale_reached),
-                cv.falls,
-                cv.robots,
-                float(cv.progress_ratio_min or 0.0),
-                float(cv.distance_m or 0.0),
-                float(walked),
-                s.sim_seconds_used_for_learning,
-                s.wall_seconds_for_learning,
-                searched[name],
-            )
-        )
-        cut = f" (stopped: more falls than {PASSES[0]})" if cv.robots < c.robots else ""
-        how = (
-            f"walked {walked / cv.robots:.1f} s on average"
-            if cv.falls == cv.robots
-            else f"slowest progress {cv.progress_ratio_min or 0.0:.2f}"
-        )
-        say(f"  {name}: {cv.falls} of {cv.robots} fell, {how}{cut}")
+        pass1 = out[0] if out else None
+        v = _walk_pass(root, name, summaries[name], robot, protocol, cfg, pass1, searched[name])
+        out.append(v)
+        _say_verdict(v, c, say)
     kept = pick(out)
     say(f"learn: keeping pass {kept}")
     return Choice(kept, tuple(out))
+
+
+def _shared_verdict(
+    out: list[PassVerdict], name: str, twin_name: str, search_s: float, say: Callable[[str], None]
+) -> PassVerdict:
+    """Pass ``name``'s verdict where its search kept pass ``twin_name``'s gait: the twin's
+    (in ``out``), with no learning of its own and its search's ``search_s`` [s]."""
+    twin = next(v for v in out if v.name == twin_name)
+    verdict = replace(
+        twin,
+        name=name,
+        learn_sim_seconds=0.0,
+        learn_wall_seconds=0.0,
+        search_sim_seconds=search_s,
+        same_as=twin.name,
+    )
+    say(f"  {name}: {twin.name}'s gait, {twin.name}'s verdict")
+    return verdict
+
+
+def _walk_pass(
+    root: RunDir,
+    name: str,
+    s: LearnSummary,
+    robot: Robot,
+    protocol: Protocol,
+    cfg: TickLearnConfig,
+    pass1: PassVerdict | None,
+    search_s: float,
+) -> PassVerdict:
+    """Pass ``name``'s learned controller (summary ``s``) walked on the choice's training
+    robots of ``protocol``; stopped once it has fallen more often than ``pass1`` at the
+    same scale. ``search_s``: its reference search's simulated seconds [s]."""
+    from imitwalk.judge.verdict import judge_protocol
+
+    c = cfg.choice
+    # at pass 1's scale, a pass that has fallen more often can no longer be kept
+    most_falls = None
+    if pass1 is not None and s.scale_reached == pass1.scale:
+        most_falls = pass1.falls
+    v = judge_protocol(
+        root.file(name),
+        robot,
+        protocol,
+        c.robots,
+        c.seconds,
+        ("learned",),
+        workers=cfg.workers,
+        first=c.first,
+        most_falls=most_falls,
+    )
+    cv = v.controllers["learned"]
+    walked = sum(r.fall_time_s if r.fell and r.fall_time_s else c.seconds for r in cv.per_seed)
+    return PassVerdict(
+        name,
+        float(s.scale_reached),
+        cv.falls,
+        cv.robots,
+        float(cv.progress_ratio_min or 0.0),
+        float(cv.distance_m or 0.0),
+        float(walked),
+        s.sim_seconds_used_for_learning,
+        s.wall_seconds_for_learning,
+        search_s,
+    )
+
+
+def _say_verdict(v: PassVerdict, c: ChoiceConfig, say: Callable[[str], None]) -> None:
+    """One progress line: how pass ``v`` walked the choice's ``c.robots`` robots."""
+    cut = f" (stopped: more falls than {PASSES[0]})" if v.robots < c.robots else ""
+    how = (
+        f"walked {v.walked_s / v.robots:.1f} s on average"
+        if v.falls == v.robots
+        else f"slowest progress {v.progress_min:.2f}"
+    )
+    say(f"  {v.name}: {v.falls} of {v.robots} fell, {how}{cut}")
 
 
 def _keep(root: RunDir, name: str) -> None:

@@ -123,10 +123,7 @@ def read_bvh(
         ``roles`` (``"names"`` or ``"structure"``), ``missing_keypoints``.
     """
     src = str(path)
-    if units is not None and units not in UNITS:
-        raise unknown_name("BVH unit", units, UNITS, MocapError)
-    if up is not None and up not in UP_AXES:
-        raise unknown_name("up axis", up, UP_AXES, MocapError)
+    _check_options(units, up)
     by_hand = load_joint_names(joint_names) if isinstance(joint_names, str | Path) else joint_names
     bvh = parse_bvh(read_lines(path), src)
     skip, tpose = _skip_tpose(bvh, skip_tpose, src)
@@ -136,20 +133,8 @@ def read_bvh(
     pos = forward_kinematics(joints, clean, 1.0)  # (T, J, 3) file axes and units
     named = name_roles(joints, src, by_hand)
     chains, feet, pelvis, hips = _legs(joints, pos, named, src)
-    legs = [pelvis, *hips, *_knees(named, chains), *feet]
-    if not np.all(np.isfinite(pos[:, legs])):
-        t = int(np.flatnonzero(~np.all(np.isfinite(pos[:, legs]), axis=(1, 2)))[0])
-        raise MocapError(
-            f"{src}: line {rows[t]}: the legs' positions overflow (a value too large?)"
-        )
-    leg = _leg_length(pos, hips, _knees(named, chains), feet[:2])
-    if not leg > 0:
-        raise MocapError(
-            f"{src}: the legs have zero length (hip, knee and ankle at one point in every "
-            "frame): zero-length bones in the rest pose?"
-        )
-    top_j = next((named[k] for k in ("head", "neck") if k in named), None)
-    top = pos[:, top_j] if top_j is not None else _centre(joints, pos, pelvis, hips)
+    leg = _checked_leg_length(pos, pelvis, hips, _knees(named, chains), feet, rows, src)
+    top = _top(joints, pos, named, pelvis, hips)
     feet_pos = pos[:, feet]  # (T, 4, 3)
     up_guessed = up is None
     why = "given"
@@ -157,14 +142,7 @@ def read_bvh(
         up, why = decide_up(top, feet_pos, leg, src)
     e_up = UP_VECTORS[up]
     fwd, fwd_how = decide_forward(pos[:, pelvis], feet_pos[:, :2], feet_pos[:, 2:], e_up, leg)
-    roles = dict(named)
-    if chains is not None:
-        if not np.any(fwd):
-            raise MocapError(
-                f"{src}: cannot tell the left leg from the right (no travel, no toes); "
-                "map them with --joint-names FILE.json"
-            )
-        roles = {**assign_sides(chains, pos, e_up, fwd), **named}
+    roles = _sided_roles(named, chains, pos, e_up, fwd, src)
     height = float(np.median(pos[:, pelvis] @ e_up - np.min(feet_pos @ e_up, axis=1)))
     guessed = units is None
     units = decide_units(leg, height, UNITS, src) if units is None else units
@@ -229,3 +207,66 @@ def _check_used(
             f"{src}: line {rows[t]}: channel {channels[c]} is {values[t, c]}, "
             "and it moves a keypoint"
         )
+
+
+def _check_options(units: str | None, up: str | None) -> None:
+    """An unknown unit or up axis -> MocapError listing the valid ones."""
+    if units is not None and units not in UNITS:
+        raise unknown_name("BVH unit", units, UNITS, MocapError)
+    if up is not None and up not in UP_AXES:
+        raise unknown_name("up axis", up, UP_AXES, MocapError)
+
+
+def _checked_leg_length(
+    pos: np.ndarray,
+    pelvis: int,
+    hips: list[int],
+    knees: list[int],
+    feet: list[int],
+    rows: np.ndarray,
+    src: str,
+) -> float:
+    """The legs' length (:func:`_leg_length`, units of ``pos`` ``(T, J, 3)``); MocapError
+    if a leg joint's position overflows or the legs have zero length."""
+    legs = [pelvis, *hips, *knees, *feet]
+    if not np.all(np.isfinite(pos[:, legs])):
+        t = int(np.flatnonzero(~np.all(np.isfinite(pos[:, legs]), axis=(1, 2)))[0])
+        raise MocapError(
+            f"{src}: line {rows[t]}: the legs' positions overflow (a value too large?)"
+        )
+    leg = _leg_length(pos, hips, knees, feet[:2])
+    if not leg > 0:
+        raise MocapError(
+            f"{src}: the legs have zero length (hip, knee and ankle at one point in every "
+            "frame): zero-length bones in the rest pose?"
+        )
+    return leg
+
+
+def _top(
+    joints: list[Joint], pos: np.ndarray, named: dict[str, int], pelvis: int, hips: list[int]
+) -> np.ndarray:
+    """``(T, 3)`` the body's top: the head, else the neck, else the upper body's centre."""
+    top_j = next((named[k] for k in ("head", "neck") if k in named), None)
+    return pos[:, top_j] if top_j is not None else _centre(joints, pos, pelvis, hips)
+
+
+def _sided_roles(
+    named: dict[str, int],
+    chains: tuple[LegChain, LegChain] | None,
+    pos: np.ndarray,
+    e_up: np.ndarray,
+    fwd: np.ndarray,
+    src: str,
+) -> dict[str, int]:
+    """Keypoint -> joint: the named joints, and legs found by structure given their side
+    (``e_up`` ``(3,)`` up, ``fwd`` ``(3,)`` direction of travel, file axes)."""
+    roles = dict(named)
+    if chains is not None:
+        if not np.any(fwd):
+            raise MocapError(
+                f"{src}: cannot tell the left leg from the right (no travel, no toes); "
+                "map them with --joint-names FILE.json"
+            )
+        roles = {**assign_sides(chains, pos, e_up, fwd), **named}
+    return roles

@@ -34,7 +34,7 @@ import numpy as np
 from imitwalk.errors import MocapError, unknown_name
 from imitwalk.mocap._common import UP_AXES, check_keypoints, z_up
 from imitwalk.mocap.bounds import check_leg, check_motion
-from imitwalk.mocap.c3d_file import POINT_UNITS, read_trial
+from imitwalk.mocap.c3d_file import POINT_UNITS, C3dTrial, read_trial
 from imitwalk.mocap.gaps import GapTooLong, fill_gaps
 from imitwalk.mocap.motion import KEYPOINTS, LOWER_BODY, Motion
 from imitwalk.mocap.orient import decide_up
@@ -96,6 +96,133 @@ def _hip_centres(
     return out[0], out[1]
 
 
+class _Markers:
+    """A trial's marker trajectories by Plug-in-Gait role, each gap-filled once [mm]."""
+
+    def __init__(self, trial: C3dTrial, src: str, max_gap: float) -> None:
+        """Index ``trial``'s labels; gaps up to ``max_gap`` [s] will be filled."""
+        self.src = src
+        self.xyz, self.fps = trial.xyz, trial.fps
+        self.to_mm = POINT_UNITS[trial.units] * 1000.0
+        # lookup by upper-case label without a "Subject:" prefix; the first of duplicates wins
+        labels = trial.labels
+        self.index = {
+            lab.rsplit(":", 1)[-1].upper(): i for i, lab in reversed(list(enumerate(labels)))
+        }
+        self.max_frames = int(round(max_gap * trial.fps))
+        self.filled: list[str] = []
+        self._cache: dict[str, np.ndarray] = {}
+
+    def get(self, role: str) -> np.ndarray:
+        """Filled ``(T, 3)`` trajectory [mm] of a role such as ``LKNE`` or ``C7``."""
+        if role not in self._cache:
+            if role in _CENTRAL:
+                names = _CENTRAL[role]
+            elif role[1:] in MARKER_ALIASES:
+                names = tuple(role[0] + a for a in MARKER_ALIASES[role[1:]])
+            else:
+                names = (role,)
+            label = next((n for n in names if n in self.index), None)
+            if label is None:
+                raise MocapError(
+                    f"{self.src}: required marker {role} not found (tried {', '.join(names)})"
+                )
+            column = self.xyz[:, self.index[label]] * self.to_mm
+            try:
+                self._cache[role], notes = fill_gaps(column, self.max_frames, label, self.fps)
+            except GapTooLong as exc:
+                raise GapTooLong(f"{self.src}: {exc}") from None
+            self.filled.extend(notes)
+        return self._cache[role]
+
+    def has(self, role: str) -> bool:
+        """Whether the trial has a usable marker for ``role`` (fills it on the way)."""
+        try:
+            self.get(role)
+        except MocapError:
+            return False
+        return True
+
+    def mean(self, *roles: str) -> np.ndarray:
+        """The mean ``(T, 3)`` trajectory [mm] of these roles' markers (summed in order)."""
+        total = self.get(roles[0])
+        for role in roles[1:]:
+            total = total + self.get(role)
+        return total / len(roles)
+
+
+def _model_output_keypoints(marker: _Markers) -> dict[str, np.ndarray]:
+    """Pelvis, hips, knees and ankles ``(T, 3)`` [mm] from the Plug-in-Gait model outputs."""
+    kp: dict[str, np.ndarray] = {}
+    kp["pelvis"] = marker.get("PELO")
+    for s in "LR":
+        kp[f"{s.lower()}_hip"], kp[f"{s.lower()}_knee"] = (
+            marker.get(f"{s}FEP"),
+            marker.get(f"{s}FEO"),
+        )
+        kp[f"{s.lower()}_ankle"] = marker.get(f"{s}TIO")
+    return kp
+
+
+def _marker_keypoints(marker: _Markers, widths: dict[str, float]) -> dict[str, np.ndarray]:
+    """Pelvis, hips (Harrington 2007), knees and ankles ``(T, 3)`` [mm] from the markers;
+    ``widths``: the trial's joint widths [mm]."""
+    kp: dict[str, np.ndarray] = {}
+    has = marker.has
+    back = marker.get("SACR") if has("SACR") else (marker.get("LPSI") + marker.get("RPSI")) / 2
+    kp["l_hip"], kp["r_hip"] = _hip_centres(marker.get("LASI"), marker.get("RASI"), back)
+    kp["pelvis"] = (kp["l_hip"] + kp["r_hip"]) / 2
+    for s in "LR":
+        k = s.lower()
+        knee_off = widths.get(f"{s}KNEEWIDTH", 100.0) / 2 + _MARKER_RADIUS_MM
+        ankle_off = widths.get(f"{s}ANKLEWIDTH", 70.0) / 2 + _MARKER_RADIUS_MM
+        lat = marker.get(f"{s}KNE")
+        kp[f"{k}_knee"] = (
+            (lat + marker.get(f"{s}KNM")) / 2
+            if has(f"{s}KNM")
+            else _chord(lat, marker.get(f"{s}THI"), kp[f"{k}_hip"], knee_off)
+        )
+        lat = marker.get(f"{s}ANK")
+        kp[f"{k}_ankle"] = (
+            (lat + marker.get(f"{s}MED")) / 2
+            if has(f"{s}MED")
+            else _chord(lat, marker.get(f"{s}TIB"), kp[f"{k}_knee"], ankle_off)
+        )
+    return kp
+
+
+def _optional_keypoints(marker: _Markers) -> tuple[dict[str, np.ndarray], tuple[str, ...]]:
+    """The upper-body keypoints ``(T, 3)`` [mm] the trial has, and the names of those it
+    lacks."""
+    optional: dict[str, Callable[[], np.ndarray]] = {
+        "neck": partial(marker.mean, "C7", "CLAV"),
+        "head": partial(marker.mean, "LFHD", "RFHD", "LBHD", "RBHD"),
+    }
+    for s in "LR":
+        optional[f"{s.lower()}_shoulder"] = partial(marker.get, f"{s}SHO")
+        optional[f"{s.lower()}_elbow"] = partial(marker.get, f"{s}ELB")
+        optional[f"{s.lower()}_wrist"] = partial(marker.mean, f"{s}WRA", f"{s}WRB")
+    found: dict[str, np.ndarray] = {}
+    missing = []
+    for key, make in optional.items():
+        try:
+            found[key] = make()
+        except MocapError:
+            missing.append(key)
+    return found, tuple(missing)
+
+
+def _guess_up(kp: dict[str, np.ndarray], src: str) -> str:
+    """The lab's up axis, told from the motion of the keypoints ``(T, 3)`` [mm]."""
+    feet = np.stack([kp[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
+    leg = np.nanmedian(np.linalg.norm(kp["l_knee"] - kp["l_hip"], axis=1))
+    leg += np.nanmedian(np.linalg.norm(kp["l_ankle"] - kp["l_knee"], axis=1))  # [mm]
+    check_leg(float(leg) / 1000.0, src, "check POINT:UNITS")
+    top = kp.get("neck", kp["pelvis"])
+    up, _ = decide_up(top, feet, float(leg), src)
+    return up
+
+
 def read_c3d(
     path: str | Path,
     *,
@@ -122,99 +249,18 @@ def read_c3d(
         raise unknown_name("up axis", up, UP_AXES, MocapError)
     trial = read_trial(path)
     xyz, labels, fps, units = trial.xyz, trial.labels, trial.fps, trial.units
-    to_mm = POINT_UNITS[units] * 1000.0
-    # lookup by upper-case label without a "Subject:" prefix; the first of duplicates wins
-    index = {lab.rsplit(":", 1)[-1].upper(): i for i, lab in reversed(list(enumerate(labels)))}
-    max_frames = int(round(max_gap * fps))
-    filled: list[str] = []
-    cache: dict[str, np.ndarray] = {}
-
-    def marker(role: str) -> np.ndarray:
-        """Filled ``(T, 3)`` trajectory [mm] of a role such as ``LKNE`` or ``C7``."""
-        if role not in cache:
-            if role in _CENTRAL:
-                names = _CENTRAL[role]
-            elif role[1:] in MARKER_ALIASES:
-                names = tuple(role[0] + a for a in MARKER_ALIASES[role[1:]])
-            else:
-                names = (role,)
-            label = next((n for n in names if n in index), None)
-            if label is None:
-                raise MocapError(
-                    f"{src}: required marker {role} not found (tried {', '.join(names)})"
-                )
-            try:
-                cache[role], notes = fill_gaps(xyz[:, index[label]] * to_mm, max_frames, label, fps)
-            except GapTooLong as exc:
-                raise GapTooLong(f"{src}: {exc}") from None
-            filled.extend(notes)
-        return cache[role]
-
-    def has(role: str) -> bool:
-        try:
-            marker(role)
-        except MocapError:
-            return False
-        return True
-
-    kp: dict[str, np.ndarray] = {}
-    use_pig = use_model_outputs and all(p in index for p in _PIG)
+    marker = _Markers(trial, src, max_gap)
+    use_pig = use_model_outputs and all(p in marker.index for p in _PIG)
     if use_pig:
-        kp["pelvis"] = marker("PELO")
-        for s in "LR":
-            kp[f"{s.lower()}_hip"], kp[f"{s.lower()}_knee"] = marker(f"{s}FEP"), marker(f"{s}FEO")
-            kp[f"{s.lower()}_ankle"] = marker(f"{s}TIO")
+        kp = _model_output_keypoints(marker)
     else:
-        back = marker("SACR") if has("SACR") else (marker("LPSI") + marker("RPSI")) / 2
-        kp["l_hip"], kp["r_hip"] = _hip_centres(marker("LASI"), marker("RASI"), back)
-        kp["pelvis"] = (kp["l_hip"] + kp["r_hip"]) / 2
-        for s in "LR":
-            k = s.lower()
-            knee_off = trial.widths.get(f"{s}KNEEWIDTH", 100.0) / 2 + _MARKER_RADIUS_MM
-            ankle_off = trial.widths.get(f"{s}ANKLEWIDTH", 70.0) / 2 + _MARKER_RADIUS_MM
-            lat = marker(f"{s}KNE")
-            kp[f"{k}_knee"] = (
-                (lat + marker(f"{s}KNM")) / 2
-                if has(f"{s}KNM")
-                else _chord(lat, marker(f"{s}THI"), kp[f"{k}_hip"], knee_off)
-            )
-            lat = marker(f"{s}ANK")
-            kp[f"{k}_ankle"] = (
-                (lat + marker(f"{s}MED")) / 2
-                if has(f"{s}MED")
-                else _chord(lat, marker(f"{s}TIB"), kp[f"{k}_knee"], ankle_off)
-            )
-    kp["l_toe"], kp["r_toe"] = marker("LTOE"), marker("RTOE")
-
-    def mean(*roles: str) -> np.ndarray:
-        """The mean ``(T, 3)`` trajectory [mm] of these roles' markers (summed in order)."""
-        total = marker(roles[0])
-        for role in roles[1:]:
-            total = total + marker(role)
-        return total / len(roles)
-
-    optional: dict[str, Callable[[], np.ndarray]] = {
-        "neck": partial(mean, "C7", "CLAV"),
-        "head": partial(mean, "LFHD", "RFHD", "LBHD", "RBHD"),
-    }
-    for s in "LR":
-        optional[f"{s.lower()}_shoulder"] = partial(marker, f"{s}SHO")
-        optional[f"{s.lower()}_elbow"] = partial(marker, f"{s}ELB")
-        optional[f"{s.lower()}_wrist"] = partial(mean, f"{s}WRA", f"{s}WRB")
-    missing = []
-    for key, make in optional.items():
-        try:
-            kp[key] = make()
-        except MocapError:
-            missing.append(key)
+        kp = _marker_keypoints(marker, trial.widths)
+    kp["l_toe"], kp["r_toe"] = marker.get("LTOE"), marker.get("RTOE")
+    optional, missing = _optional_keypoints(marker)
+    kp.update(optional)
     guessed = up is None
     if up is None:
-        feet = np.stack([kp[k] for k in ("l_ankle", "r_ankle", "l_toe", "r_toe")], axis=1)
-        leg = np.nanmedian(np.linalg.norm(kp["l_knee"] - kp["l_hip"], axis=1))
-        leg += np.nanmedian(np.linalg.norm(kp["l_ankle"] - kp["l_knee"], axis=1))  # [mm]
-        check_leg(float(leg) / 1000.0, src, "check POINT:UNITS")
-        top = kp.get("neck", kp["pelvis"])
-        up, _ = decide_up(top, feet, float(leg), src)
+        up = _guess_up(kp, src)
     keypoints = check_keypoints(
         {k: z_up(kp[k] / 1000.0, up) for k in KEYPOINTS if k in kp}, src, len(xyz), LOWER_BODY
     )
@@ -224,10 +270,11 @@ def read_c3d(
         "up_axis": up,
         "up_guessed": guessed,
         "hip_method": "plug-in-gait outputs" if use_pig else "harrington2007",
-        "missing_keypoints": tuple(missing),
+        "missing_keypoints": missing,
         "events": list(trial.events),
         "first_frame": trial.first_frame,
     }
     data = xyz.reshape(len(xyz), -1)
-    motion = Motion(fps, channels, data, keypoints, src, "c3d", filled=tuple(filled), meta=meta)
+    filled = tuple(marker.filled)
+    motion = Motion(fps, channels, data, keypoints, src, "c3d", filled=filled, meta=meta)
     return check_motion(motion, "check POINT:UNITS")

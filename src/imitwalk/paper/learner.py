@@ -21,8 +21,9 @@ import numpy as np
 from imitwalk.config import from_dict, to_dict
 from imitwalk.paper.episode import EpisodeJob, run_episode
 from imitwalk.paper.gait import GaitModel
-from imitwalk.paper.learnconfig import LearnConfig
+from imitwalk.paper.learnconfig import LearnConfig, ScheduleConfig
 from imitwalk.paper.models import fit_model, stack_episodes, unstack_episodes
+from imitwalk.paper.predictor import SensoryMotorModel
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
@@ -96,14 +97,7 @@ def learn(
         the learning summary (also written as ``metrics.json``).
     """
     rd = RunDir(run_dir)
-    cfg_json = {
-        "learn": to_dict(config),
-        "reference": ref.summary(),
-        "robot": robot.name,
-        "learner": "faithful",
-    }
-    canonical = lambda learn: to_dict(from_dict(LearnConfig, learn))  # noqa: E731
-    saved, log = rd.start(cfg_json, ref, resume, canonical)
+    saved, log = _open_run(rd, ref, robot, config, resume)
     state = FaithfulProgress(**saved) if saved else FaithfulProgress()
     data = unstack_episodes(rd.read_arrays("data.npz")) if saved and rd.exists("data.npz") else []
     sch = config.schedule
@@ -113,46 +107,13 @@ def learn(
         t0 = time.perf_counter()
         scale, it = scales[state.scale_index], state.iteration
         model = fit_model(data, config)
-        explore = max(0.0, 1.0 - it / (sch.iterations - 1)) if sch.iterations > 1 else 0.0
-        jobs = [
-            EpisodeJob(
-                robot,
-                gait,
-                scale,
-                config,
-                model,
-                s,
-                explore,
-                (config.seed, state.total_iterations, j),
-                sch.seconds,
-            )
-            for j, s in enumerate(train_seeds(config.train_models))
-        ]
+        jobs = _episode_jobs(robot, gait, scale, config, model, it, state.total_iterations)
         results = run_parallel(run_episode, jobs, config.workers)
-        new = [r["tick"] for r in results if "tick" in r and len(r["tick"][0]) > 3]
-        report = None
-        if model is not None and new:
-            try:
-                report = model.evaluate(new).to_dict()
-            except ValueError:
-                report = None
+        report = _prediction_report(model, results)
         data.extend(r["tick"] for r in results if "tick" in r and len(r["tick"][0]) > 2)
         entry = _iteration_log(scale, it, results, report, t0)
         log.append(entry)
-        fell, last = entry["falls"] > 0, it >= sch.iterations - 1
-        if fell:
-            state.failures += 1
-            state.done = state.failures > sch.retries
-        if last and not fell:
-            state.passed.append(scale)
-            state.failures = 0
-            state.scale_index, state.iteration = state.scale_index + 1, 0
-            state.done = state.scale_index >= len(scales)
-        elif not state.done:
-            state.iteration = min(it + 1, sch.iterations - 1)
-        state.total_iterations += 1
-        state.sim_seconds += entry["sim_seconds"]
-        state.wall_seconds += entry["wall_seconds"]
+        _advance(state, entry, scale, it, sch, len(scales))
         rd.write_arrays("data.npz", stack_episodes(data))
         rd.write_log(log)
         rd.write_json("checkpoint.json", asdict(state))
@@ -171,6 +132,89 @@ def learn(
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary
+
+
+def _open_run(
+    rd: RunDir, ref: Reference, robot: Robot, config: LearnConfig, resume: bool
+) -> tuple[dict | None, list[dict]]:
+    """Start the run folder ``rd`` (or, with ``resume``, reopen it): the saved progress
+    (``None``: a fresh run) and the log so far."""
+    cfg_json = {
+        "learn": to_dict(config),
+        "reference": ref.summary(),
+        "robot": robot.name,
+        "learner": "faithful",
+    }
+    canonical = lambda learn: to_dict(from_dict(LearnConfig, learn))  # noqa: E731
+    return rd.start(cfg_json, ref, resume, canonical)
+
+
+def _episode_jobs(
+    robot: Robot,
+    gait: GaitModel,
+    scale: float,
+    config: LearnConfig,
+    model: SensoryMotorModel | None,
+    it: int,
+    total_iterations: int,
+) -> list[EpisodeJob]:
+    """One episode per training robot at ``scale``, exploring less as iteration ``it`` of
+    the scale nears the last."""
+    sch = config.schedule
+    explore = max(0.0, 1.0 - it / (sch.iterations - 1)) if sch.iterations > 1 else 0.0
+    return [
+        EpisodeJob(
+            robot,
+            gait,
+            scale,
+            config,
+            model,
+            s,
+            explore,
+            (config.seed, total_iterations, j),
+            sch.seconds,
+        )
+        for j, s in enumerate(train_seeds(config.train_models))
+    ]
+
+
+def _prediction_report(model: SensoryMotorModel | None, results: list[dict]) -> dict | None:
+    """How well ``model`` predicted the new episodes of more than three ticks (``None``:
+    no model, no such episode, or it could not be evaluated)."""
+    new = [r["tick"] for r in results if "tick" in r and len(r["tick"][0]) > 3]
+    report = None
+    if model is not None and new:
+        try:
+            report = model.evaluate(new).to_dict()
+        except ValueError:
+            report = None
+    return report
+
+
+def _advance(
+    state: FaithfulProgress,
+    entry: dict,
+    scale: float,
+    it: int,
+    sch: ScheduleConfig,
+    n_scales: int,
+) -> None:
+    """Move ``state`` on after iteration ``it`` at ``scale`` (logged as ``entry``): pass the
+    scale, retry it, or stop."""
+    fell, last = entry["falls"] > 0, it >= sch.iterations - 1
+    if fell:
+        state.failures += 1
+        state.done = state.failures > sch.retries
+    if last and not fell:
+        state.passed.append(scale)
+        state.failures = 0
+        state.scale_index, state.iteration = state.scale_index + 1, 0
+        state.done = state.scale_index >= n_scales
+    elif not state.done:
+        state.iteration = min(it + 1, sch.iterations - 1)
+    state.total_iterations += 1
+    state.sim_seconds += entry["sim_seconds"]
+    state.wall_seconds += entry["wall_seconds"]
 
 
 def _progress_line(e: dict) -> str:

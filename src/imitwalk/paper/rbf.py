@@ -49,6 +49,37 @@ def ridge_lstsq(Phi: np.ndarray, B: np.ndarray, ridge: float, penalised: np.ndar
     return np.linalg.lstsq(lhs, rhs, rcond=None)[0]
 
 
+def _checked_data(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs ``(N, d)`` and targets ``(N,)`` or ``(N, m)`` as float arrays; ValueError if
+    their shapes do not fit or they are not finite."""
+    A = np.asarray(A, dtype=float)
+    B = np.asarray(B, dtype=float)
+    if A.ndim != 2 or B.ndim not in (1, 2) or len(B) != len(A) or len(A) == 0:
+        raise ValueError(f"expected A (N, d) and B (N,) or (N, m), got {A.shape}, {B.shape}")
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
+        raise ValueError("inputs or targets contain NaN or inf")
+    return A, B
+
+
+def _standardisation(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and scale ``(d,)`` of the inputs ``A`` ``(N, d)`` (scale 1 on a constant input)."""
+    mean = A.mean(axis=0)
+    scale = A.std(axis=0)
+    scale = np.where(scale > 1e-12 * (1.0 + np.abs(mean)), scale, 1.0)
+    return mean, scale
+
+
+def _nearest_centre_sq(C: np.ndarray, d: int) -> np.ndarray:
+    """``(K,)`` squared distance d_k² from each centre of ``C`` ``(K, d)`` to its nearest
+    other one (a coincident or lone centre gets the median of the others, else ``d``)."""
+    K = len(C)
+    D2 = np.sum((C[:, None, :] - C[None, :, :]) ** 2, axis=-1)  # (K, K)
+    np.fill_diagonal(D2, np.inf)
+    dnn2 = D2.min(axis=1) if K > 1 else np.full(1, np.inf)
+    ok = np.isfinite(dnn2) & (dnn2 > 1e-24)
+    return np.where(ok, dnn2, np.median(dnn2[ok]) if ok.any() else float(d))
+
+
 class RBFNetwork(RegressorMixin, BaseEstimator):
     """Gaussian RBF network β = F'(α), eq. (4).
 
@@ -110,19 +141,28 @@ class RBFNetwork(RegressorMixin, BaseEstimator):
 
     def _fit(self, A: np.ndarray, B: np.ndarray) -> RBFNetwork:
         self._check_params()
-        A = np.asarray(A, dtype=float)
-        B = np.asarray(B, dtype=float)
-        if A.ndim != 2 or B.ndim not in (1, 2) or len(B) != len(A) or len(A) == 0:
-            raise ValueError(f"expected A (N, d) and B (N,) or (N, m), got {A.shape}, {B.shape}")
-        if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
-            raise ValueError("inputs or targets contain NaN or inf")
+        A, B = _checked_data(A, B)
         self._1d, self._linear = B.ndim == 1, bool(self.linear)
         B2 = B.reshape(len(B), -1)  # (N, m)
-        N, d = A.shape
-        mean = A.mean(axis=0)
-        scale = A.std(axis=0)
-        scale = np.where(scale > 1e-12 * (1.0 + np.abs(mean)), scale, 1.0)
+        d = A.shape[1]
+        mean, scale = _standardisation(A)
         Z = (A - mean) / scale  # (N, d) standardised
+        C, labels = self._centres(Z)
+        K = len(C)
+        dnn2 = _nearest_centre_sq(C, d)
+        P = self._set_precisions(Z, C, labels, dnn2)
+        self.input_mean_, self.input_scale_ = mean, scale
+        self.n_features_in_ = d
+        self.n_outputs_ = B2.shape[1]
+        self._fit_weights(Z, B2, K, mean, scale)
+        self.centers_ = mean + C * scale  # (K, d)
+        self.precisions_ = P / np.outer(scale, scale)  # (K, d, d) Σ_k⁻¹ in input units
+        return self
+
+    def _centres(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kernel centres ``(K, d)`` and each input's centre ``(N,)`` for standardised
+        inputs ``Z`` ``(N, d)``: every input if there are few, else k-means."""
+        N = len(Z)
         distinct, inverse = np.unique(Z, axis=0, return_inverse=True)
         if N <= self.n_centers:
             C, labels = Z.copy(), np.arange(N)
@@ -133,12 +173,14 @@ class RBFNetwork(RegressorMixin, BaseEstimator):
             km = KMeans(n_clusters=int(self.n_centers), n_init=3, random_state=self.random_state)
             km.fit(Z)
             C, labels = km.cluster_centers_, km.labels_
-        K = len(C)
-        D2 = np.sum((C[:, None, :] - C[None, :, :]) ** 2, axis=-1)  # (K, K)
-        np.fill_diagonal(D2, np.inf)
-        dnn2 = D2.min(axis=1) if K > 1 else np.full(1, np.inf)
-        ok = np.isfinite(dnn2) & (dnn2 > 1e-24)
-        dnn2 = np.where(ok, dnn2, np.median(dnn2[ok]) if ok.any() else float(d))
+        return C, labels
+
+    def _set_precisions(
+        self, Z: np.ndarray, C: np.ndarray, labels: np.ndarray, dnn2: np.ndarray
+    ) -> np.ndarray:
+        """Each kernel's precision Σ_k⁻¹ ``(K, d, d)`` in standardised units, from its
+        cluster's spread and ``dnn2`` ``(K,)``; sets the products :meth:`_kernels` uses."""
+        K, d = len(C), Z.shape[1]
         dev = Z - C[labels]  # (N, d) deviation from own centre
         counts = np.bincount(labels, minlength=K).astype(float)  # (K,)
         w2 = self.width**2
@@ -166,9 +208,14 @@ class RBFNetwork(RegressorMixin, BaseEstimator):
             self._cp = C * self._pdiag  # (K, d)
             self._c2p = np.sum(C * self._cp, axis=1)  # (K,)
             P = np.einsum("kd,de->kde", self._pdiag, np.eye(d))
-        self.input_mean_, self.input_scale_ = mean, scale
-        self.n_features_in_ = d
-        self.n_outputs_ = B2.shape[1]
+        return P
+
+    def _fit_weights(
+        self, Z: np.ndarray, B2: np.ndarray, K: int, mean: np.ndarray, scale: np.ndarray
+    ) -> None:
+        """Output weights, linear terms and bias by ridge least squares on ``Z`` ``(N, d)``
+        -> ``B2`` ``(N, m)``, in input units (``mean``, ``scale`` ``(d,)``)."""
+        d = Z.shape[1]
         Phi = self._design(Z)  # (N, K + 1 [+ d])
         pen = np.ones(Phi.shape[1], dtype=bool)
         pen[K] = False  # bias column
@@ -177,9 +224,6 @@ class RBFNetwork(RegressorMixin, BaseEstimator):
         lin = W[K + 1 :] / scale[:, None] if self._linear else np.zeros((d, B2.shape[1]))
         self.linear_coef_ = lin  # (d, m) in input units
         self.intercept_ = W[K] - mean @ lin  # (m,)
-        self.centers_ = mean + C * scale  # (K, d)
-        self.precisions_ = P / np.outer(scale, scale)  # (K, d, d) Σ_k⁻¹ in input units
-        return self
 
     def _kernels(self, Z: np.ndarray) -> np.ndarray:
         """Eq. (4) kernel activations for standardised inputs: ``(N, d) -> (N, K)``."""

@@ -11,6 +11,7 @@ paper's too: the joint pattern is shrunk about its mean.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import mink
 import mujoco
@@ -67,27 +68,41 @@ def _walk_frame(k: dict) -> dict:
     return {n: (p - o) @ rot.T for n, p in k.items()}
 
 
-def human_ik(motion: Motion, robot: Robot, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Joint angles ``(F, n)`` [rad] of the given source frames, and which hit a limit."""
-    k = _walk_frame(motion.keypoints)
-    m = _human_sized(robot, k)
-    cfg = mink.Configuration(m)
-    cfg.update(robot.stand_qpos.copy())
+#: Keypoint -> the robot role whose body the IK puts on it.
+_POINTS = {
+    "l_knee": "l_knee",
+    "r_knee": "r_knee",
+    "l_ankle": "l_ankle_pitch",
+    "r_ankle": "r_ankle_pitch",
+    "l_elbow": "l_elbow",
+    "r_elbow": "r_elbow",
+    "l_wrist": "l_hand",
+    "r_wrist": "r_hand",
+}
+
+
+@dataclass(frozen=True)
+class _Tasks:
+    """The IK's tasks on the human-sized model: the pelvis pose, the keypoints' positions
+    (keypoint -> task), the feet's orientations (side -> task) and the standing posture."""
+
+    pelvis: mink.FrameTask
+    points: dict[str, mink.FrameTask]
+    feet: dict[str, mink.FrameTask]
+    posture: mink.PostureTask
+
+    def all(self) -> list[mink.Task]:
+        """Every task, in the order the IK is given them."""
+        return [self.pelvis, *self.points.values(), *self.feet.values(), self.posture]
+
+
+def _tasks(m: mujoco.MjModel, robot: Robot, k: dict) -> _Tasks:
+    """The tasks on the human-sized model ``m`` for the keypoints ``k`` the clip has."""
     root = m.body(int(m.body_rootid[m.body(robot.torso).id])).name
     pelvis = mink.FrameTask(root, "body", 5.0, 5.0)
-    points = {
-        "l_knee": "l_knee",
-        "r_knee": "r_knee",
-        "l_ankle": "l_ankle_pitch",
-        "r_ankle": "r_ankle_pitch",
-        "l_elbow": "l_elbow",
-        "r_elbow": "r_elbow",
-        "l_wrist": "l_hand",
-        "r_wrist": "r_hand",
-    }
     tasks = {
         kp: mink.FrameTask(m.body(_body(m, robot, role)).name, "body", 10.0, 0.0)
-        for kp, role in points.items()
+        for kp, role in _POINTS.items()
         if kp in k and role in robot.joint_names
     }
     feet = {
@@ -96,38 +111,61 @@ def human_ik(motion: Motion, robot: Robot, frames: np.ndarray) -> tuple[np.ndarr
     }
     posture = mink.PostureTask(m, cost=1e-3)
     posture.set_target(robot.stand_qpos)
+    return _Tasks(pelvis, tasks, feet, posture)
+
+
+def _set_targets(tasks: _Tasks, k: dict, f: int, hip_mid: np.ndarray, off: np.ndarray) -> None:
+    """Aim the tasks at source frame ``f``: the pelvis ``off`` ``(3,)`` [m] below the hips'
+    mid-point ``hip_mid`` ``(T, 3)`` facing as they do, the keypoints, the feet."""
+    x = k["l_hip"][f] - k["r_hip"][f]
+    x = np.cross(x, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    yaw = np.arctan2(x[1], x[0])
+    pose = mink.SE3.from_rotation_and_translation(
+        mink.SO3.from_rpy_radians(0, 0, yaw), hip_mid[f] - off
+    )
+    tasks.pelvis.set_target(pose)
+    for kp, t in tasks.points.items():
+        t.set_target(mink.SE3.from_translation(k[kp][f]))
+    for s in "lr":
+        v = k[f"{s}_toe"][f] - k[f"{s}_ankle"][f]
+        fyaw, fpitch = np.arctan2(v[1], v[0]), -np.arctan2(v[2], np.hypot(v[0], v[1]))
+        tasks.feet[s].set_target(mink.SE3.from_rotation(mink.SO3.from_rpy_radians(0, fpitch, fyaw)))
+
+
+def _solve_frame(
+    cfg: mink.Configuration, tasks: _Tasks, limits: list[mink.ConfigurationLimit]
+) -> None:
+    """Move ``cfg`` onto the tasks' targets (at most 20 IK steps)."""
+    for _ in range(20):
+        vel = mink.solve_ik(
+            cfg,
+            tasks.all(),
+            1.0,
+            "daqp",
+            damping=1e-6,
+            limits=limits,
+        )
+        cfg.integrate_inplace(vel, 1.0)
+        if np.abs(vel).max() < 1e-5:
+            break
+
+
+def human_ik(motion: Motion, robot: Robot, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Joint angles ``(F, n)`` [rad] of the given source frames, and which hit a limit."""
+    k = _walk_frame(motion.keypoints)
+    m = _human_sized(robot, k)
+    cfg = mink.Configuration(m)
+    cfg.update(robot.stand_qpos.copy())
+    tasks = _tasks(m, robot, k)
     limits = [mink.ConfigurationLimit(m)]
     qadr = np.array([m.jnt_qposadr[m.joint(j).id] for j in robot.mj_joints])
     hip_mid = (k["l_hip"] + k["r_hip"]) / 2
     off = np.array([0.0, 0.0, float(np.mean(m.body_pos[_body(m, robot, "l_hip_yaw")][2]))])
     out = np.zeros((len(frames), robot.dof))
     for i, f in enumerate(frames):
-        x = k["l_hip"][f] - k["r_hip"][f]
-        x = np.cross(x, [0.0, 0.0, 1.0])
-        x /= np.linalg.norm(x)
-        yaw = np.arctan2(x[1], x[0])
-        pose = mink.SE3.from_rotation_and_translation(
-            mink.SO3.from_rpy_radians(0, 0, yaw), hip_mid[f] - off
-        )
-        pelvis.set_target(pose)
-        for kp, t in tasks.items():
-            t.set_target(mink.SE3.from_translation(k[kp][f]))
-        for s in "lr":
-            v = k[f"{s}_toe"][f] - k[f"{s}_ankle"][f]
-            fyaw, fpitch = np.arctan2(v[1], v[0]), -np.arctan2(v[2], np.hypot(v[0], v[1]))
-            feet[s].set_target(mink.SE3.from_rotation(mink.SO3.from_rpy_radians(0, fpitch, fyaw)))
-        for _ in range(20):
-            vel = mink.solve_ik(
-                cfg,
-                [pelvis, *tasks.values(), *feet.values(), posture],
-                1.0,
-                "daqp",
-                damping=1e-6,
-                limits=limits,
-            )
-            cfg.integrate_inplace(vel, 1.0)
-            if np.abs(vel).max() < 1e-5:
-                break
+        _set_targets(tasks, k, f, hip_mid, off)
+        _solve_frame(cfg, tasks, limits)
         out[i] = cfg.q[qadr] * robot.signs
     at_limit = (out <= robot.limits[:, 0] + 1e-3) | (out >= robot.limits[:, 1] - 1e-3)
     return robot.clip(out), at_limit

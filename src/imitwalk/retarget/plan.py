@@ -103,6 +103,160 @@ def _profile(p: np.ndarray, s: np.ndarray) -> np.ndarray:
     return np.interp(s, np.linspace(0.0, 1.0, len(p)), p)
 
 
+@dataclass(frozen=True)
+class _Clock:
+    """The plan's ticks: ``n`` of them, the first ``n_out`` returned (one more cycle is laid
+    out, so the last steps land where the next cycle expects), ``n_cyc`` per cycle.
+
+    ``k`` ``(n,)`` tick index; ``psi`` ``(n,)`` phase ψ; ``e`` ``(n,)`` stride envelope;
+    ``e_sway`` ``(n,)`` sway envelope; ``stepping`` ``(n,)`` bool, the feet may step.
+    """
+
+    n: int
+    n_out: int
+    n_cyc: int
+    k: np.ndarray
+    psi: np.ndarray
+    e: np.ndarray
+    e_sway: np.ndarray
+    stepping: np.ndarray
+
+
+@dataclass(frozen=True)
+class _FootTrack:
+    """Per-tick foot targets: ``soles`` ``{"l", "r"}`` -> ``(n, 3)`` sole centre [m];
+    ``yaw`` ``(n, 2)`` sole heading [rad]; ``stance`` ``(n, 2)`` bool; ``swing`` ``(n, 2)``
+    swing progress σ (NaN in stance)."""
+
+    soles: dict[str, np.ndarray]
+    yaw: np.ndarray
+    stance: np.ndarray
+    swing: np.ndarray
+
+
+def _stance_half_width(
+    geom: LegGeometry, params: GaitParams, cmd: GaitCommand, scale: float
+) -> float:
+    """Lateral distance of each sole from the walking line [m]."""
+    # a sidestep's closing step brings the feet half a sidestep closer than they stand:
+    # the stance widens if that would leave less than FOOT_GAP between the soles
+    y_foot = geom.hip_y + params.width
+    if cmd.side_m:
+        side = abs(cmd.side_m * scale)
+        y_foot = max(y_foot, (geom.foot_width + leg_scaled(FOOT_GAP, geom.leg) + side / 2) / 2)
+    return y_foot
+
+
+def _clock(n_cyc: int, cycles: int, start: bool) -> _Clock:
+    """Ticks, phase and envelopes of ``cycles`` steady cycles of ``n_cyc`` ticks, after the
+    start-up cycles if ``start``."""
+    ramp = START_CYCLES if start else 0
+    n_out = n_cyc * (ramp + cycles)
+    n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
+    k = np.arange(n)
+    psi = (k % n_cyc) / n_cyc
+    # the sway builds up over the first start-up cycle (feet down), so the lateral rocking
+    # is in full swing before a foot leaves the floor; then the stride grows over the
+    # other start-up cycles, slowly enough that no step is longer than a steady one
+    e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
+    e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
+    stepping = k >= (n_cyc if start else 0)
+    return _Clock(n, n_out, n_cyc, k, psi, e, e_sway, stepping)
+
+
+def _lift_shape(template: GaitTemplate) -> np.ndarray:
+    """``(PHASES,)`` the swing foot's lift profile, at least a half sine, peak 1."""
+    shape_z = np.maximum(
+        template.swing_z, np.sin(np.pi * np.linspace(0.0, 1.0, len(template.swing_z)))
+    )
+    shape_z /= shape_z.max()
+    return shape_z
+
+
+def _landing_spot(
+    clock: _Clock,
+    path: np.ndarray,
+    i: int,
+    sigma: float,
+    window: tuple[float, float],
+    ds: float,
+    stride: float,
+    lateral: float,
+) -> np.ndarray:
+    """Where a foot lifting off at tick ``i`` lands: ``(3,)`` x, y [m] and heading [rad],
+    a quarter stride ahead of the walking frame ``path`` ``(n, 5)`` at mid swing."""
+    a, b = window
+    n_cyc = clock.n_cyc
+    t_mid = i - sigma * (b - a) * n_cyc + (b - a + ds / 2) * n_cyc  # fractional
+    ahead = float(np.interp(t_mid, clock.k, clock.e)) * stride / 4
+    xy, th = place(path, t_mid, np.array([ahead, lateral]))
+    return np.array([*xy, th])
+
+
+def _foot_track(
+    clock: _Clock,
+    template: GaitTemplate,
+    params: GaitParams,
+    path: np.ndarray,
+    stride: float,
+    ds: float,
+    y_foot: float,
+    start: bool,
+) -> _FootTrack:
+    """Both feet, tick by tick: flat and fixed in stance, along the human foot path in
+    swing (``path`` ``(n, 5)`` the walking frame; ``y_foot`` [m] each sole off its line)."""
+    n, n_cyc, psi = clock.n, clock.n_cyc, clock.psi
+    soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
+    yaw = np.zeros((n, 2))
+    stance = np.zeros((n, 2), dtype=bool)
+    swing = np.full((n, 2), np.nan)
+    # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
+    windows = {"r": (ds, 0.5), "l": (0.5 + ds, 1.0)}
+    lateral = {"l": y_foot, "r": -y_foot}
+    land = {  # where each foot stands: x, y [m] and heading [rad]
+        "l": np.array([0.0, y_foot, 0.0]),
+        "r": np.array([0.0 if start else -stride / 2, -y_foot, 0.0]),
+    }
+    lift_off = dict(land)
+    shape_z = _lift_shape(template)
+    for i in range(n):
+        for j, f in enumerate("lr"):
+            a, b = windows[f]
+            if clock.stepping[i] and a <= psi[i] < b:
+                sigma = (psi[i] - a) / (b - a)
+                if sigma * (b - a) * n_cyc < 1.0:  # first swing tick: choose the landing spot
+                    lift_off[f] = land[f]
+                    land[f] = _landing_spot(
+                        clock, path, i, sigma, windows[f], ds, stride, lateral[f]
+                    )
+                u = _profile(template.swing_x, sigma)
+                soles[f][i, :2] = lift_off[f][:2] + (land[f][:2] - lift_off[f][:2]) * u
+                soles[f][i, 2] = params.lift * _profile(shape_z, sigma)
+                yaw[i, j] = lift_off[f][2] + (land[f][2] - lift_off[f][2]) * u
+                swing[i, j] = sigma
+            else:
+                soles[f][i] = (*land[f][:2], 0.0)
+                yaw[i, j] = land[f][2]
+                stance[i, j] = True
+    return _FootTrack(soles, yaw, stance, swing)
+
+
+def _arm_swing(template: GaitTemplate, clock: _Clock, scale: float) -> dict[str, np.ndarray]:
+    """Role -> ``(n,)`` arm and waist angle offsets from the standing posture [rad], the
+    human's swing over ψ scaled with the stride."""
+    psi = clock.psi
+    grid = np.arange(len(template.waist)) / len(template.waist)
+    arm = lambda prof: np.interp(psi, grid, prof, period=1.0)  # noqa: E731
+    amp = clock.e * scale
+    return {
+        "l_shoulder_pitch": -amp * arm(template.shoulder[:, 0] - template.shoulder[:, 0].mean()),
+        "r_shoulder_pitch": -amp * arm(template.shoulder[:, 1] - template.shoulder[:, 1].mean()),
+        "l_elbow": -amp * arm(template.elbow[:, 0] - template.elbow[:, 0].mean()),
+        "r_elbow": -amp * arm(template.elbow[:, 1] - template.elbow[:, 1].mean()),
+        "waist_yaw": amp * arm(template.waist),
+    }
+
+
 def plan_walk(
     template: GaitTemplate,
     geom: LegGeometry,
@@ -141,102 +295,43 @@ def plan_walk(
     period = n_cyc * dt
     stride = cmd.forward * scale * template.stride * geom.leg / template.leg_length
     ds = float(np.clip(params.ds, 0.0, 0.45))
-    # a sidestep's closing step brings the feet half a sidestep closer than they stand:
-    # the stance widens if that would leave less than FOOT_GAP between the soles
-    y_foot = geom.hip_y + params.width
-    if cmd.side_m:
-        side = abs(cmd.side_m * scale)
-        y_foot = max(y_foot, (geom.foot_width + leg_scaled(FOOT_GAP, geom.leg) + side / 2) / 2)
+    y_foot = _stance_half_width(geom, params, cmd, scale)
     if not start and (cmd.turn_deg or cmd.side_m):
         raise ConfigError("a turning or sidestepping plan needs start=True")
-    ramp = START_CYCLES if start else 0
-    n_out = n_cyc * (ramp + cycles)
-    n = n_out + n_cyc  # one extra cycle, so the last steps land where the next cycle expects
-    k = np.arange(n)
-    psi = (k % n_cyc) / n_cyc
-    # the sway builds up over the first start-up cycle (feet down), so the lateral rocking
-    # is in full swing before a foot leaves the floor; then the stride grows over the
-    # other start-up cycles, slowly enough that no step is longer than a steady one
-    e = np.ones(n) if not start else _smoothstep((k - n_cyc) / ((ramp - 1) * n_cyc))
-    e_sway = np.ones(n) if not start else _smoothstep(k / n_cyc)
-    stepping = k >= (n_cyc if start else 0)
-    path = walking_frame(e, stride / period, cmd, scale, period, dt)  # (N, 5)
+    clock = _clock(n_cyc, cycles, start)
+    path = walking_frame(clock.e, stride / period, cmd, scale, period, dt)  # (N, 5)
     if not start:  # steady: CoM midway between the feet at mid double support
         path[:, 0] -= stride / 4 + stride * ds / 2
-    com_y = e_sway * params.sway * y_foot * np.sin(2 * np.pi * (psi - ds / 2))
-    soles = {"l": np.zeros((n, 3)), "r": np.zeros((n, 3))}
-    yaw = np.zeros((n, 2))
-    stance = np.zeros((n, 2), dtype=bool)
-    swing = np.full((n, 2), np.nan)
-    # swing windows in phase: right [ds, 0.5), left [0.5 + ds, 1)
-    windows = {"r": (ds, 0.5), "l": (0.5 + ds, 1.0)}
-    lateral = {"l": y_foot, "r": -y_foot}
-    land = {  # where each foot stands: x, y [m] and heading [rad]
-        "l": np.array([0.0, y_foot, 0.0]),
-        "r": np.array([0.0 if start else -stride / 2, -y_foot, 0.0]),
-    }
-    lift_off = dict(land)
-    shape_z = np.maximum(
-        template.swing_z, np.sin(np.pi * np.linspace(0.0, 1.0, len(template.swing_z)))
-    )
-    shape_z /= shape_z.max()
-    for i in range(n):
-        for j, f in enumerate("lr"):
-            a, b = windows[f]
-            if stepping[i] and a <= psi[i] < b:
-                sigma = (psi[i] - a) / (b - a)
-                if sigma * (b - a) * n_cyc < 1.0:  # first swing tick: choose the landing spot
-                    lift_off[f] = land[f]
-                    t_mid = i - sigma * (b - a) * n_cyc + (b - a + ds / 2) * n_cyc  # fractional
-                    ahead = float(np.interp(t_mid, k, e)) * stride / 4
-                    xy, th = place(path, t_mid, np.array([ahead, lateral[f]]))
-                    land[f] = np.array([*xy, th])
-                u = _profile(template.swing_x, sigma)
-                soles[f][i, :2] = lift_off[f][:2] + (land[f][:2] - lift_off[f][:2]) * u
-                soles[f][i, 2] = params.lift * _profile(shape_z, sigma)
-                yaw[i, j] = lift_off[f][2] + (land[f][2] - lift_off[f][2]) * u
-                swing[i, j] = sigma
-            else:
-                soles[f][i] = (*land[f][:2], 0.0)
-                yaw[i, j] = land[f][2]
-                stance[i, j] = True
+    com_y = clock.e_sway * params.sway * y_foot * np.sin(2 * np.pi * (clock.psi - ds / 2))
+    feet = _foot_track(clock, template, params, path, stride, ds, y_foot, start)
     hip = params.height * geom.hip_height
     if cap_scale is not None:
         hip = min(hip, knee_cap(template, geom, params, max(cap_scale, scale), start, cmd))
-    pelvis_z = np.full(n, hip + geom.hip_z)
+    pelvis_z = np.full(clock.n, hip + geom.hip_z)
     pitch = float(np.radians(cmd.slope_deg))
     # on a slope the CoM sits over the feet along gravity: its height × tan(slope) uphill
     lean = params.lean + (hip + geom.hip_z) * np.tan(pitch)
     c, s = np.cos(path[:, 2]), np.sin(path[:, 2])
     com = path[:, :2] + np.stack([c * lean - s * com_y, s * lean + c * com_y], axis=1)
-    grid = np.arange(len(template.waist)) / len(template.waist)
-    arm = lambda prof: np.interp(psi, grid, prof, period=1.0)  # noqa: E731
-    amp = e * scale
-    upper = {
-        "l_shoulder_pitch": -amp * arm(template.shoulder[:, 0] - template.shoulder[:, 0].mean()),
-        "r_shoulder_pitch": -amp * arm(template.shoulder[:, 1] - template.shoulder[:, 1].mean()),
-        "l_elbow": -amp * arm(template.elbow[:, 0] - template.elbow[:, 0].mean()),
-        "r_elbow": -amp * arm(template.elbow[:, 1] - template.elbow[:, 1].mean()),
-        "waist_yaw": amp * arm(template.waist),
-    }
-    cut = slice(0, n_out)
+    upper = _arm_swing(template, clock, scale)
+    cut = slice(0, clock.n_out)
     return TaskPlan(
         dt=dt,
-        l_sole=soles["l"][cut],
-        r_sole=soles["r"][cut],
+        l_sole=feet.soles["l"][cut],
+        r_sole=feet.soles["r"][cut],
         com=com[cut],
         pelvis_z=pelvis_z[cut],
         upper={key: val[cut] for key, val in upper.items()},
-        phase=psi[cut],
-        stance=stance[cut],
-        swing=swing[cut],
-        envelope=e[cut],
+        phase=clock.psi[cut],
+        stance=feet.stance[cut],
+        swing=feet.swing[cut],
+        envelope=clock.e[cut],
         stride=stride,
         period=period,
-        yaw=yaw[cut],
+        yaw=feet.yaw[cut],
         pitch=pitch,
         path=path[cut],
-        motion=cycle_motion(path, n_out - n_cyc, n_cyc),
+        motion=cycle_motion(path, clock.n_out - n_cyc, n_cyc),
     )
 
 

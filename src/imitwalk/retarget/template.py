@@ -184,20 +184,11 @@ def _one_cycle(
 ) -> dict:
     """Per-cycle figures; ``[a, b)`` runs from a left heel strike to the next."""
     n = b - a
-    fwd = fwd_all[a:b].mean(axis=0)
-    fwd[2] = 0.0
-    fwd /= np.linalg.norm(fwd)
-    up = np.array([0.0, 0.0, 1.0])
+    fwd = _cycle_heading(fwd_all, a, b)
     t = np.arange(n) / fps
     mids = {f: (kp[f"{f}_ankle"][a:b] + kp[f"{f}_toe"][a:b]) / 2 for f in "lr"}
-    stance_v = []
-    for f in "lr":
-        c = contacts[f][a:b]
-        v = np.gradient(mids[f] @ fwd) * fps
-        stance_v.append(v[c])
-    belt = float(np.median(np.concatenate(stance_v))) if any(len(s) for s in stance_v) else 0.0
-    ground = lambda x: x - belt * t[:, None] * fwd  # noqa: E731  (add the belt's travel back)
-    pelvis = ground(kp["pelvis"][a:b])
+    belt = _belt_speed(mids, contacts, fwd, a, b, fps)
+    pelvis = _ground(kp["pelvis"][a:b], belt, t, fwd)
     stride = float((pelvis[-1] - pelvis[0]) @ fwd) * n / max(n - 1, 1)
     leg = float(
         np.median(
@@ -205,19 +196,82 @@ def _one_cycle(
             + np.linalg.norm(kp["l_ankle"][a:b] - kp["l_knee"][a:b], axis=1)
         )
     )
+    l_off, r_on, r_off = _foot_events(contacts, a, b)
+    ph_l_off, ph_r_on, ph_r_off = (_phase_of(x[0], 0, n) for x in (l_off, r_on, r_off))
+    stance = 0.5 * (ph_l_off + (1.0 - ph_r_on + ph_r_off) % 1.0)
+    ds = 0.5 * (ph_r_off + (ph_l_off - ph_r_on) % 1.0)
+    swings = (("l", l_off[0], n), ("r", r_off[0], r_on[0]))
+    out = {
+        "period": n / fps,
+        "stride": stride,
+        "leg": leg,
+        "stance": stance,
+        "ds": ds,
+        **_swing_profiles(mids, swings, belt, t, fwd),
+    }
+    if all(k in kp for k in _ARMS):
+        out.update(_arm_profiles(kp, fwd, a, b))
+    return out
+
+
+def _cycle_heading(fwd_all: np.ndarray, a: int, b: int) -> np.ndarray:
+    """``(3,)`` the cycle's mean horizontal heading (unit) from the per-frame ``(T, 3)``."""
+    fwd = fwd_all[a:b].mean(axis=0)
+    fwd[2] = 0.0
+    fwd /= np.linalg.norm(fwd)
+    return fwd
+
+
+def _belt_speed(
+    mids: dict[str, np.ndarray],
+    contacts: dict[str, np.ndarray],
+    fwd: np.ndarray,
+    a: int,
+    b: int,
+    fps: float,
+) -> float:
+    """A treadmill belt's speed [m/s] along ``fwd``: the median forward velocity of the
+    stance feet (``mids`` ``(n, 3)`` mid-foot per side), about 0 overground."""
+    stance_v = []
+    for f in "lr":
+        c = contacts[f][a:b]
+        v = np.gradient(mids[f] @ fwd) * fps
+        stance_v.append(v[c])
+    return float(np.median(np.concatenate(stance_v))) if any(len(s) for s in stance_v) else 0.0
+
+
+def _ground(x: np.ndarray, belt: float, t: np.ndarray, fwd: np.ndarray) -> np.ndarray:
+    """``(n, 3)`` positions in the ground frame: the belt's travel (``t`` ``(n,)`` [s])
+    added back."""
+    return x - belt * t[:, None] * fwd
+
+
+def _foot_events(
+    contacts: dict[str, np.ndarray], a: int, b: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Frames (from ``a``) of the left toe-off and the right heel strikes and toe-offs."""
     cl, cr = contacts["l"][a:b], contacts["r"][a:b]
     l_off = _runs(cl, True)
     r_on, r_off = _runs(cr, False), _runs(cr, True)
     if len(l_off) == 0 or len(r_on) == 0 or len(r_off) == 0:
         raise MocapError("gait cycle without a clear toe-off / heel strike of both feet")
-    ph_l_off, ph_r_on, ph_r_off = (_phase_of(x[0], 0, n) for x in (l_off, r_on, r_off))
-    stance = 0.5 * (ph_l_off + (1.0 - ph_r_on + ph_r_off) % 1.0)
-    ds = 0.5 * (ph_r_off + (ph_l_off - ph_r_on) % 1.0)
+    return l_off, r_on, r_off
+
+
+def _swing_profiles(
+    mids: dict[str, np.ndarray],
+    swings: tuple[tuple[str, int, int], ...],
+    belt: float,
+    t: np.ndarray,
+    fwd: np.ndarray,
+) -> dict[str, np.ndarray | float]:
+    """``swing_x``, ``swing_z`` ``(PHASES,)`` and ``lift`` [m], averaged over the
+    ``(foot, lift-off, touch-down)`` swings of the cycle."""
     sx, sz, lift = [], [], []
-    for f, off, on in (("l", l_off[0], n), ("r", r_off[0], r_on[0])):
+    for f, off, on in swings:
         if on <= off:
             continue
-        g = ground(mids[f])
+        g = _ground(mids[f], belt, t, fwd)
         x = g[off:on] @ fwd
         z = g[off:on, 2] - g[:, 2].min()
         base = np.linspace(z[0], z[-1], len(z))
@@ -229,33 +283,32 @@ def _one_cycle(
         lift.append(float((z - base).max()))
     if not sx:
         raise MocapError("gait cycle without a swing phase")
-    out = {
-        "period": n / fps,
-        "stride": stride,
-        "leg": leg,
-        "stance": stance,
-        "ds": ds,
+    return {
         "swing_x": np.mean(sx, axis=0),
         "swing_z": np.mean(sz, axis=0),
         "lift": float(np.mean(lift)),
     }
-    if all(k in kp for k in _ARMS):
-        trunk = kp["neck"][a:b] - kp["pelvis"][a:b]
-        trunk /= np.linalg.norm(trunk, axis=1, keepdims=True)
-        fwd_t = fwd - (trunk @ fwd)[:, None] * trunk
-        fwd_t /= np.linalg.norm(fwd_t, axis=1, keepdims=True)
-        sh, el = [], []
-        for f in "lr":
-            u = kp[f"{f}_elbow"][a:b] - kp[f"{f}_shoulder"][a:b]
-            w = kp[f"{f}_wrist"][a:b] - kp[f"{f}_elbow"][a:b]
-            sh.append(np.arctan2(np.sum(u * fwd_t, axis=1), -np.sum(u * trunk, axis=1)))
-            cos = np.sum(u * w, axis=1) / np.linalg.norm(u, axis=1) / np.linalg.norm(w, axis=1)
-            el.append(np.arccos(np.clip(cos, -1.0, 1.0)))
-        sl = kp["l_shoulder"][a:b] - kp["r_shoulder"][a:b]
-        hl = kp["l_hip"][a:b] - kp["r_hip"][a:b]
-        yaw = np.unwrap(np.arctan2(sl[:, 1], sl[:, 0]) - np.arctan2(hl[:, 1], hl[:, 0]))
-        out["shoulder"] = _cyclic_interp(np.stack(sh, axis=1), PHASES)
-        out["elbow"] = _cyclic_interp(np.stack(el, axis=1), PHASES)
-        out["waist"] = _cyclic_interp(yaw - yaw.mean(), PHASES)
-        _ = up
-    return out
+
+
+def _arm_profiles(kp: dict[str, np.ndarray], fwd: np.ndarray, a: int, b: int) -> dict:
+    """``shoulder``, ``elbow`` ``(PHASES, 2)`` and ``waist`` ``(PHASES,)`` [rad] over ψ of
+    the cycle ``[a, b)``."""
+    trunk = kp["neck"][a:b] - kp["pelvis"][a:b]
+    trunk /= np.linalg.norm(trunk, axis=1, keepdims=True)
+    fwd_t = fwd - (trunk @ fwd)[:, None] * trunk
+    fwd_t /= np.linalg.norm(fwd_t, axis=1, keepdims=True)
+    sh, el = [], []
+    for f in "lr":
+        u = kp[f"{f}_elbow"][a:b] - kp[f"{f}_shoulder"][a:b]
+        w = kp[f"{f}_wrist"][a:b] - kp[f"{f}_elbow"][a:b]
+        sh.append(np.arctan2(np.sum(u * fwd_t, axis=1), -np.sum(u * trunk, axis=1)))
+        cos = np.sum(u * w, axis=1) / np.linalg.norm(u, axis=1) / np.linalg.norm(w, axis=1)
+        el.append(np.arccos(np.clip(cos, -1.0, 1.0)))
+    sl = kp["l_shoulder"][a:b] - kp["r_shoulder"][a:b]
+    hl = kp["l_hip"][a:b] - kp["r_hip"][a:b]
+    yaw = np.unwrap(np.arctan2(sl[:, 1], sl[:, 0]) - np.arctan2(hl[:, 1], hl[:, 0]))
+    return {
+        "shoulder": _cyclic_interp(np.stack(sh, axis=1), PHASES),
+        "elbow": _cyclic_interp(np.stack(el, axis=1), PHASES),
+        "waist": _cyclic_interp(yaw - yaw.mean(), PHASES),
+    }

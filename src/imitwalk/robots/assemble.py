@@ -131,6 +131,125 @@ def _sole_pads(
     return TouchPads(model.body(body).name, pos, quat, (float(hx), float(hy)), names)
 
 
+@dataclass(frozen=True)
+class _Imu:
+    """The gyro the robot reads and its site; ``added_site`` ``(body, site, pos, quat)`` and
+    ``added_gyro`` ``(sensor, site)`` when they are to be added (``None``: the file's own)."""
+
+    gyro: str
+    site: str
+    added_site: tuple[str, str, tuple, tuple] | None
+    added_gyro: tuple[str, str] | None
+
+
+def _check_joints(jm: JointMap, model: mujoco.MjModel, joints_all: list[str]) -> None:
+    """Every role's joint is a hinge of ``model``; else RobotError."""
+    for role, (name, _) in jm.joints.items():
+        if name not in joints_all:
+            raise unknown_name("joint", name, [j for j in joints_all if j])
+        if model.jnt_type[model.joint(name).id] != mujoco.mjtJoint.mjJNT_HINGE:
+            raise RobotError(f"joint {name!r} (role {role}) is not a hinge joint")
+
+
+def _soles(
+    jm: JointMap, bodies: list[str], sites: list[str]
+) -> tuple[dict[str, str], list[tuple[str, SoleSpec]], set[str]]:
+    """Each side's sole site (or body) name, the sole sites to add, and the site names
+    taken once they are added."""
+    taken = set(sites)
+    soles, added_soles = {}, []
+    for side, sole in jm.soles.items():
+        if isinstance(sole, SoleSpec):
+            if sole.body not in bodies:
+                raise unknown_name(f"{side} sole body", sole.body, [b for b in bodies if b])
+            soles[side] = free_name(taken, f"{side}_sole")
+            taken.add(soles[side])
+            added_soles.append((soles[side], sole))
+        elif sole in sites or sole in bodies:
+            soles[side] = sole
+        else:
+            raise unknown_name(f"{side} sole site", sole, [x for x in sites if x])
+    return soles, added_soles, taken
+
+
+def _imu(
+    jm: JointMap,
+    model: mujoco.MjModel,
+    tree: Tree,
+    mjcf: Path,
+    torso: str,
+    sensors: list[str],
+    sites: list[str],
+    taken: set[str],
+) -> _Imu:
+    """The joint map's gyro (checked), or an IMU to add on the ``torso``, level with the
+    world at the zero posture, its site named apart from ``taken``."""
+    gyros = [
+        s for i, s in enumerate(sensors) if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_GYRO
+    ]
+    if jm.gyro is not None:
+        if not gyros:
+            raise RobotError(
+                f"{mjcf.name} has no gyro sensor {jm.gyro!r}; leave 'gyro' out of the "
+                "joint map to have an IMU added on the torso"
+            )
+        if jm.gyro not in gyros:
+            raise unknown_name("gyro sensor", jm.gyro, gyros)
+        imu_site = sites[int(model.sensor_objid[model.sensor(jm.gyro).id])]
+        return _Imu(jm.gyro, imu_site, None, None)
+    d = tree.data
+    tb = model.body(torso).id
+    quat = np.zeros(4)
+    mujoco.mju_negQuat(quat, d.xquat[tb])  # level with the world at the zero posture
+    imu_site = free_name(taken, "imu")
+    imu = (torso, imu_site, tuple(model.body_ipos[tb]), tuple(quat))
+    gyro = free_name(set(sensors), "imu_gyro")
+    return _Imu(gyro, imu_site, imu, (gyro, imu_site))
+
+
+def _accelerometer(
+    jm: JointMap, sensors: list[str], gyro: str, imu_site: str
+) -> tuple[str | None, tuple[str, str] | None]:
+    """The accelerometer the robot reads (``None``: none), and ``(sensor, site)`` if it is
+    to be added at the IMU's site."""
+    accel = accel_add = None
+    if jm.accelerometer is not None:
+        if jm.accelerometer not in sensors:
+            raise unknown_name("sensor", jm.accelerometer, [s for s in sensors if s])
+        accel = jm.accelerometer
+    elif jm.add_accelerometer:
+        accel = free_name(set(sensors) | {gyro}, "imu_accel")
+        accel_add = (accel, imu_site)
+    return accel, accel_add
+
+
+def _foot_force(
+    jm: JointMap,
+    model: mujoco.MjModel,
+    tree: Tree,
+    sensors: list[str],
+    taken: set[str | None],
+) -> tuple[dict[str, tuple[str, ...]], list[TouchPads]]:
+    """The foot sensors per side: the joint map's (checked), or touch pads to add under
+    each sole, named apart from ``taken``."""
+    pads = []
+    if jm.foot_force is not None:
+        foot_force = jm.foot_force
+        for name in foot_force["l"] + foot_force["r"]:
+            if name not in sensors:
+                raise unknown_name("sensor", name, [s for s in sensors if s])
+    else:
+        used = set(taken)
+        foot_force = {}
+        for side in ("l", "r"):
+            names = tuple(free_name(used, f"{side}_fsr_{q}") for q in FSR_LAYOUT)
+            used |= set(names)
+            foot_force[side] = names
+            # one name per entry of FSR_LAYOUT (4), which mypy cannot see through tuple()
+            pads.append(_sole_pads(model, tree.data, tree, side, jm.soles[side], names))  # type: ignore[arg-type]
+    return foot_force, pads
+
+
 def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf: Path) -> tuple[Additions, Resolved]:
     """Check ``jm``'s names against ``model`` (the user's file compiled as it is) and
     list what building the robot adds.
@@ -145,76 +264,18 @@ def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf: Path) -> tuple[Add
     bodies = _names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody)
     sites = _names(model, mujoco.mjtObj.mjOBJ_SITE, model.nsite)
     roles = tuple(jm.joints)
-    for role, (name, _) in jm.joints.items():
-        if name not in joints_all:
-            raise unknown_name("joint", name, [j for j in joints_all if j])
-        if model.jnt_type[model.joint(name).id] != mujoco.mjtJoint.mjJNT_HINGE:
-            raise RobotError(f"joint {name!r} (role {role}) is not a hinge joint")
+    _check_joints(jm, model, joints_all)
     joints = tuple(jm.joints[r][0] for r in roles)
     signs = tuple(jm.joints[r][1] for r in roles)
     torso = jm.torso or tree.name(tree.root)
     if torso not in bodies:
         raise unknown_name("torso body", torso, [b for b in bodies if b])
-    taken = set(sites)
-    soles, added_soles = {}, []
-    for side, sole in jm.soles.items():
-        if isinstance(sole, SoleSpec):
-            if sole.body not in bodies:
-                raise unknown_name(f"{side} sole body", sole.body, [b for b in bodies if b])
-            soles[side] = free_name(taken, f"{side}_sole")
-            taken.add(soles[side])
-            added_soles.append((soles[side], sole))
-        elif sole in sites or sole in bodies:
-            soles[side] = sole
-        else:
-            raise unknown_name(f"{side} sole site", sole, [x for x in sites if x])
-    gyros = [
-        s for i, s in enumerate(sensors) if model.sensor_type[i] == mujoco.mjtSensor.mjSENS_GYRO
-    ]
-    imu = gyro_add = None
-    if jm.gyro is not None:
-        if not gyros:
-            raise RobotError(
-                f"{mjcf.name} has no gyro sensor {jm.gyro!r}; leave 'gyro' out of the "
-                "joint map to have an IMU added on the torso"
-            )
-        if jm.gyro not in gyros:
-            raise unknown_name("gyro sensor", jm.gyro, gyros)
-        imu_site = sites[int(model.sensor_objid[model.sensor(jm.gyro).id])]
-        gyro = jm.gyro
-    else:
-        d = tree.data
-        tb = model.body(torso).id
-        quat = np.zeros(4)
-        mujoco.mju_negQuat(quat, d.xquat[tb])  # level with the world at the zero posture
-        imu_site = free_name(taken, "imu")
-        taken.add(imu_site)
-        imu = (torso, imu_site, tuple(model.body_ipos[tb]), tuple(quat))
-        gyro = free_name(set(sensors), "imu_gyro")
-        gyro_add = (gyro, imu_site)
-    accel = accel_add = None
-    if jm.accelerometer is not None:
-        if jm.accelerometer not in sensors:
-            raise unknown_name("sensor", jm.accelerometer, [s for s in sensors if s])
-        accel = jm.accelerometer
-    elif jm.add_accelerometer:
-        accel = free_name(set(sensors) | {gyro}, "imu_accel")
-        accel_add = (accel, imu_site)
-    pads = []
-    if jm.foot_force is not None:
-        foot_force = jm.foot_force
-        for name in foot_force["l"] + foot_force["r"]:
-            if name not in sensors:
-                raise unknown_name("sensor", name, [s for s in sensors if s])
-    else:
-        used = set(sensors) | {gyro, accel} | taken
-        foot_force = {}
-        for side in ("l", "r"):
-            names = tuple(free_name(used, f"{side}_fsr_{q}") for q in FSR_LAYOUT)
-            used |= set(names)
-            foot_force[side] = names
-            # one name per entry of FSR_LAYOUT (4), which mypy cannot see through tuple()
-            pads.append(_sole_pads(model, tree.data, tree, side, jm.soles[side], names))  # type: ignore[arg-type]
+    soles, added_soles, taken = _soles(jm, bodies, sites)
+    imu = _imu(jm, model, tree, mjcf, torso, sensors, sites, taken)
+    taken.add(imu.site)  # already there if it is the file's own
+    gyro = imu.gyro
+    accel, accel_add = _accelerometer(jm, sensors, gyro, imu.site)
+    foot_force, pads = _foot_force(jm, model, tree, sensors, set(sensors) | {gyro, accel} | taken)
     floor = not any(
         model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE and model.geom_bodyid[g] == 0
         for g in range(model.ngeom)
@@ -225,8 +286,8 @@ def plan_additions(jm: JointMap, model: mujoco.MjModel, mjcf: Path) -> tuple[Add
         sky=not (model.tex_type == mujoco.mjtTexture.mjTEXTURE_SKYBOX).any(),
         soles=tuple(added_soles),
         pads=tuple(pads),
-        imu=imu,
-        gyro=gyro_add,
+        imu=imu.added_site,
+        gyro=imu.added_gyro,
         accelerometer=accel_add,
         servos=_servos(jm, model, roles, joints, tree),
     )

@@ -236,24 +236,8 @@ def parse_joint_map(data: dict, source: str = "") -> JointMap:
     for key in data:
         if key not in MAP_KEYS:
             raise unknown_name("joint-map key", str(key), MAP_KEYS)
-    jm = data.get("joints")
-    if not isinstance(jm, dict) or not jm:
-        raise RobotError(f"joint map {src} has no 'joints' object (role -> MJCF joint name)")
-    for role in jm:
-        if role not in ROLES:
-            raise unknown_name("joint role", role, ROLES)
-    missing = [r for r in LEG_ROLES if r not in jm]
-    if missing:
-        raise RobotError(f"joint map {src} lacks leg roles: {', '.join(missing)}")
-    joints = {r: _joint(r, jm[r], src) for r in ROLES if r in jm}
-    soles = _object(data.get("soles"), src, "soles", 'sides "l" and "r"')
-    for side in soles:
-        if side not in _SIDES:
-            raise unknown_name("side in 'soles'", str(side), _SIDES)
-    for side in _SIDES:
-        if side not in soles:
-            raise RobotError(f"{_where(src, 'soles')} has no {side!r} sole")
-    out: _Fields = {"soles": {s: _sole(s, soles[s], src) for s in _SIDES}}
+    joints = _parse_joints(data.get("joints"), src)
+    out: _Fields = {"soles": _parse_soles(data.get("soles"), src)}
     for name_key in _NAME_KEYS:
         if name_key in data:
             out[name_key] = _string(data[name_key], src, name_key)
@@ -262,38 +246,83 @@ def parse_joint_map(data: dict, source: str = "") -> JointMap:
         out["accelerometer"] = None if acc is None else _string(acc, src, "accelerometer")
         out["add_accelerometer"] = False
     if "foot_force" in data:
-        ff = _object(data["foot_force"], src, "foot_force", 'sides "l" and "r" -> sensor names')
-        for side in ff:
-            if side not in _SIDES:
-                raise unknown_name("side in 'foot_force'", str(side), _SIDES)
-        out["foot_force"] = {}
-        for side in _SIDES:
-            names = ff.get(side, [])
-            if not isinstance(names, list):
-                raise RobotError(f"{_where(src, 'foot_force.' + side)} must be a list of names")
-            key = f"foot_force.{side}"
-            out["foot_force"][side] = tuple(_string(n, src, key) for n in names)
+        out["foot_force"] = _parse_foot_force(data["foot_force"], src)
     if "stand" in data:
-        stand = _object(data["stand"], src, "stand", "role -> angle [rad]")
-        for role in stand:
-            if role not in joints:
-                raise unknown_name("joint role in 'stand'", str(role), tuple(joints))
-        out["stand"] = {r: _number(v, src, f"stand.{r}") for r, v in stand.items()}
+        out["stand"] = _parse_stand(data["stand"], joints, src)
     if "servos" in data:
-        servos = _object(data["servos"], src, "servos", "role or group -> gains")
-        valid = (*SERVO_GROUPS, *joints)
-        out["servos"] = {}
-        for key, gains in servos.items():
-            if key not in valid:
-                raise unknown_name("role or group in 'servos'", str(key), valid)
-            gains = _object(gains, src, f"servos.{key}", "kp, kv, torque_limit")
-            for g in gains:
-                if g not in _SERVO_KEYS:
-                    raise unknown_name(f"gain in servos.{key}", str(g), _SERVO_KEYS)
-            out["servos"][key] = {
-                g: _number(v, src, f"servos.{key}.{g}", positive=g != "kv")
-                for g, v in gains.items()
-            }
-            if out["servos"][key].get("kv", 0.0) < 0:
-                raise RobotError(f"{_where(src, f'servos.{key}.kv')} must be >= 0")
+        out["servos"] = _parse_servos(data["servos"], joints, src)
     return JointMap(source=src, joints=joints, **out)
+
+
+def _parse_joints(jm: object, src: str) -> dict[str, tuple[str, float]]:
+    """``joints``: role -> (MJCF joint name, sign ±1), in :data:`ROLES` order, every leg
+    role present."""
+    if not isinstance(jm, dict) or not jm:
+        raise RobotError(f"joint map {src} has no 'joints' object (role -> MJCF joint name)")
+    for role in jm:
+        if role not in ROLES:
+            raise unknown_name("joint role", role, ROLES)
+    missing = [r for r in LEG_ROLES if r not in jm]
+    if missing:
+        raise RobotError(f"joint map {src} lacks leg roles: {', '.join(missing)}")
+    return {r: _joint(r, jm[r], src) for r in ROLES if r in jm}
+
+
+def _parse_soles(value: object, src: str) -> dict[str, str | SoleSpec]:
+    """``soles``: side ``"l"``/``"r"`` -> a site or body name, or a sole site to add."""
+    soles = _object(value, src, "soles", 'sides "l" and "r"')
+    for side in soles:
+        if side not in _SIDES:
+            raise unknown_name("side in 'soles'", str(side), _SIDES)
+    for side in _SIDES:
+        if side not in soles:
+            raise RobotError(f"{_where(src, 'soles')} has no {side!r} sole")
+    return {s: _sole(s, soles[s], src) for s in _SIDES}
+
+
+def _parse_foot_force(value: object, src: str) -> dict[str, tuple[str, ...]]:
+    """``foot_force``: side -> the names of the force or touch sensors under that sole."""
+    ff = _object(value, src, "foot_force", 'sides "l" and "r" -> sensor names')
+    for side in ff:
+        if side not in _SIDES:
+            raise unknown_name("side in 'foot_force'", str(side), _SIDES)
+    foot_force = {}
+    for side in _SIDES:
+        names = ff.get(side, [])
+        if not isinstance(names, list):
+            raise RobotError(f"{_where(src, 'foot_force.' + side)} must be a list of names")
+        key = f"foot_force.{side}"
+        foot_force[side] = tuple(_string(n, src, key) for n in names)
+    return foot_force
+
+
+def _parse_stand(value: object, joints: dict[str, tuple[str, float]], src: str) -> dict[str, float]:
+    """``stand``: role (one of ``joints``) -> standing angle [rad], canonical signs."""
+    stand = _object(value, src, "stand", "role -> angle [rad]")
+    for role in stand:
+        if role not in joints:
+            raise unknown_name("joint role in 'stand'", str(role), tuple(joints))
+    return {r: _number(v, src, f"stand.{r}") for r, v in stand.items()}
+
+
+def _parse_servos(
+    value: object, joints: dict[str, tuple[str, float]], src: str
+) -> dict[str, dict[str, float]]:
+    """``servos``: role or group -> gains (``kp`` [Nm/rad], ``kv`` [Nm s/rad],
+    ``torque_limit`` [Nm])."""
+    servos = _object(value, src, "servos", "role or group -> gains")
+    valid = (*SERVO_GROUPS, *joints)
+    out: dict[str, dict[str, float]] = {}
+    for key, gains in servos.items():
+        if key not in valid:
+            raise unknown_name("role or group in 'servos'", str(key), valid)
+        gains = _object(gains, src, f"servos.{key}", "kp, kv, torque_limit")
+        for g in gains:
+            if g not in _SERVO_KEYS:
+                raise unknown_name(f"gain in servos.{key}", str(g), _SERVO_KEYS)
+        out[key] = {
+            g: _number(v, src, f"servos.{key}.{g}", positive=g != "kv") for g, v in gains.items()
+        }
+        if out[key].get("kv", 0.0) < 0:
+            raise RobotError(f"{_where(src, f'servos.{key}.kv')} must be >= 0")
+    return out

@@ -135,50 +135,17 @@ def _build(
     roles, mj_joints, signs = res.roles, res.joints, np.array(res.signs)
     root = int(model.body_rootid[model.body(res.torso).id])
     check_masses(model, mjcf, float(model.body_subtreemass[root]))
-    data = mujoco.MjData(model)
-    key = jm.stand_keyframe
-    if key is not None:
-        keys = _names(model, mujoco.mjtObj.mjOBJ_KEY, model.nkey)
-        if key not in keys:
-            raise unknown_name("keyframe", key, keys)
-        mujoco.mj_resetDataKeyframe(model, data, model.key(key).id)
+    data = _keyframe_data(model, jm.stand_keyframe)
     jid = np.array([model.joint(j).id for j in mj_joints])
     adr = model.jnt_qposadr[jid]
-    for role, val in jm.stand.items():
-        data.qpos[adr[roles.index(role)]] = val * signs[roles.index(role)]
-    mujoco.mj_kinematics(model, data)
-    if key is None or jm.stand:  # not the file's own posture: put it on the floor
-        low = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
-        data.qpos[2] -= low - SOLE_CLEARANCE
-    mujoco.mj_forward(model, data)
-    if not np.isfinite(data.qpos).all() or not np.isfinite(data.xpos).all():
-        raise RobotError(f"{mjcf.name}: the standing posture is not finite")
+    _stand(model, data, jm, res, adr, signs, mjcf)
     acts = {
         int(model.actuator_trnid[a, 0]): a
         for a in range(model.nu)
         if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
     }
-    kp, tl, ranges = [], [], []
-    for name, j in zip(mj_joints, jid, strict=True):
-        a = acts.get(int(j))
-        if a is None or actuator_kind(model, a) != "position":
-            raise RobotError(f"joint {name!r} has no position servo; imitwalk needs one per joint")
-        kp.append(float(model.actuator_gainprm[a, 0]))
-        tl.append(torque_limit(model, a, int(j)))
-        if model.jnt_limited[j]:
-            ranges.append(model.jnt_range[j])
-        elif model.actuator_ctrllimited[a]:
-            ranges.append(model.actuator_ctrlrange[a])
-        else:
-            ranges.append((-np.pi, np.pi))
-    limits = np.sort(np.array(ranges, dtype=float) * signs[:, None], axis=1)
-    ctrl = np.zeros(model.nu)
-    for j, a in acts.items():
-        if actuator_kind(model, a) == "position":
-            lo, hi = (
-                model.actuator_ctrlrange[a] if model.actuator_ctrllimited[a] else (-np.inf, np.inf)
-            )
-            ctrl[a] = np.clip(data.qpos[model.jnt_qposadr[j]], lo, hi)
+    kp, tl, limits = _servo_table(model, mj_joints, jid, acts, signs)
+    ctrl = _stand_ctrl(model, data, acts)
     sole_z = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
     mass, height = float(model.body_subtreemass[root]), _top(model, data) - sole_z
     torso_z = float(data.xpos[model.body(res.torso).id][2] - sole_z)
@@ -208,6 +175,80 @@ def _build(
         additions=add,
         stand_ctrl=ctrl,
     )
+
+
+def _keyframe_data(model: mujoco.MjModel, key: str | None) -> mujoco.MjData:
+    """Fresh data of ``model``, at the keyframe ``key`` if one is named."""
+    data = mujoco.MjData(model)
+    if key is not None:
+        keys = _names(model, mujoco.mjtObj.mjOBJ_KEY, model.nkey)
+        if key not in keys:
+            raise unknown_name("keyframe", key, keys)
+        mujoco.mj_resetDataKeyframe(model, data, model.key(key).id)
+    return data
+
+
+def _stand(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    jm: JointMap,
+    res: Resolved,
+    adr: np.ndarray,
+    signs: np.ndarray,
+    mjcf: Path,
+) -> None:
+    """Put ``data`` in the standing posture: the map's angles [rad] at qpos ``adr`` ``(n,)``,
+    lowered onto the floor unless it is the file's own keyframe; RobotError if not finite."""
+    key = jm.stand_keyframe
+    roles = res.roles
+    for role, val in jm.stand.items():
+        data.qpos[adr[roles.index(role)]] = val * signs[roles.index(role)]
+    mujoco.mj_kinematics(model, data)
+    if key is None or jm.stand:  # not the file's own posture: put it on the floor
+        low = min(_frame_pos(model, data, res.soles[s])[2] for s in SIDES)
+        data.qpos[2] -= low - SOLE_CLEARANCE
+    mujoco.mj_forward(model, data)
+    if not np.isfinite(data.qpos).all() or not np.isfinite(data.xpos).all():
+        raise RobotError(f"{mjcf.name}: the standing posture is not finite")
+
+
+def _servo_table(
+    model: mujoco.MjModel,
+    mj_joints: tuple[str, ...],
+    jid: np.ndarray,
+    acts: dict[int, int],
+    signs: np.ndarray,
+) -> tuple[list[float], list[float], np.ndarray]:
+    """Each role joint's servo stiffness [Nm/rad], torque limit [Nm] and ``(n, 2)`` range
+    [rad], canonical signs; RobotError if a joint has no position servo."""
+    kp, tl, ranges = [], [], []
+    for name, j in zip(mj_joints, jid, strict=True):
+        a = acts.get(int(j))
+        if a is None or actuator_kind(model, a) != "position":
+            raise RobotError(f"joint {name!r} has no position servo; imitwalk needs one per joint")
+        kp.append(float(model.actuator_gainprm[a, 0]))
+        tl.append(torque_limit(model, a, int(j)))
+        if model.jnt_limited[j]:
+            ranges.append(model.jnt_range[j])
+        elif model.actuator_ctrllimited[a]:
+            ranges.append(model.actuator_ctrlrange[a])
+        else:
+            ranges.append((-np.pi, np.pi))
+    limits = np.sort(np.array(ranges, dtype=float) * signs[:, None], axis=1)
+    return kp, tl, limits
+
+
+def _stand_ctrl(model: mujoco.MjModel, data: mujoco.MjData, acts: dict[int, int]) -> np.ndarray:
+    """``(nu,)`` every actuator's control in the posture of ``data``: each position servo
+    holds its joint's angle (within its control range), others 0."""
+    ctrl = np.zeros(model.nu)
+    for j, a in acts.items():
+        if actuator_kind(model, a) == "position":
+            lo, hi = (
+                model.actuator_ctrlrange[a] if model.actuator_ctrllimited[a] else (-np.inf, np.inf)
+            )
+            ctrl[a] = np.clip(data.qpos[model.jnt_qposadr[j]], lo, hi)
+    return ctrl
 
 
 def _frame_pos(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:

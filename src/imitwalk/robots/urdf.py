@@ -111,6 +111,26 @@ def to_urdf(robot: Robot, com_shift: Sequence[float] = (0.0, 0.0, 0.0)) -> UrdfR
     m = robot.compile()
     m.body_ipos[m.body(robot.torso).id] += np.asarray(com_shift, dtype=float)
     names = [m.body(b).name or f"body{b}" for b in range(m.nbody)]
+    shift, joint_of, base = _joint_layout(m, names)
+    out = [f"<robot name={quoteattr(robot.name)}>"]
+    friction = np.zeros(m.nbody)
+    meshes: dict[int, str] = {}  # mesh id -> file name, for the collision meshes used
+    for b in range(1, m.nbody):
+        link, friction[b] = _link(m, b, names[b], shift[b], meshes)
+        out.append(link)
+    for b in range(1, m.nbody):
+        if b == base:
+            continue
+        out.append(_joint(m, b, names, shift, joint_of))
+    out.append("</robot>")
+    moved = tuple(names[m.joint(mj).bodyid[0]] for mj in robot.mj_joints)
+    objs = {name: _obj(m, mid) for mid, name in meshes.items()}
+    return UrdfRobot("\n".join(out), ("", *names[1:]), names[base], moved, friction, objs)
+
+
+def _joint_layout(m: mujoco.MjModel, names: list[str]) -> tuple[np.ndarray, dict[int, int], int]:
+    """Each body's hinge position ``(nbody, 3)`` in its frame [m] (0 without one), body ->
+    its hinge joint, and the free-floating root body."""
     shift = np.zeros((m.nbody, 3))
     joint_of: dict[int, int] = {}
     base = None
@@ -130,56 +150,64 @@ def to_urdf(robot: Robot, com_shift: Sequence[float] = (0.0, 0.0, 0.0)) -> UrdfR
             shift[b] = m.jnt_pos[j0]
     if base is None:
         raise RobotError("URDF export needs a free-floating root body (a freejoint)")
-    out = [f"<robot name={quoteattr(robot.name)}>"]
-    friction = np.zeros(m.nbody)
-    meshes: dict[int, str] = {}  # mesh id -> file name, for the collision meshes used
-    for b in range(1, m.nbody):
-        mass = max(float(m.body_mass[b]), 1e-6)
-        ipos = m.body_ipos[b] - shift[b]
-        inertia = np.maximum(m.body_inertia[b], 1e-9)
-        body = [f"<link name={quoteattr(names[b])}><inertial>"]
-        body.append(f'<origin xyz="{_v(ipos)}" rpy="{_v(_rpy(m.body_iquat[b]))}"/>')
-        body.append(f'<mass value="{mass:.9g}"/>')
-        body.append(
-            f'<inertia ixx="{inertia[0]:.9g}" iyy="{inertia[1]:.9g}" izz="{inertia[2]:.9g}"'
-            ' ixy="0" ixz="0" iyz="0"/></inertial>'
+    return shift, joint_of, base
+
+
+def _link(
+    m: mujoco.MjModel, b: int, name: str, shift: np.ndarray, meshes: dict[int, str]
+) -> tuple[str, float]:
+    """Body ``b``'s ``<link>`` (origin at its hinge, ``shift`` ``(3,)`` [m] in its frame),
+    and the largest sliding friction of its colliding geoms (0 without any)."""
+    friction = 0.0
+    mass = max(float(m.body_mass[b]), 1e-6)
+    ipos = m.body_ipos[b] - shift
+    inertia = np.maximum(m.body_inertia[b], 1e-9)
+    body = [f"<link name={quoteattr(name)}><inertial>"]
+    body.append(f'<origin xyz="{_v(ipos)}" rpy="{_v(_rpy(m.body_iquat[b]))}"/>')
+    body.append(f'<mass value="{mass:.9g}"/>')
+    body.append(
+        f'<inertia ixx="{inertia[0]:.9g}" iyy="{inertia[1]:.9g}" izz="{inertia[2]:.9g}"'
+        ' ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+    for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
+        if m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0:
+            continue  # visual only
+        xml = _geom(m, g, shift, meshes)
+        if xml is not None:
+            body.append(xml)
+            friction = max(friction, float(m.geom_friction[g, 0]))
+    body.append("</link>")
+    return "".join(body), friction
+
+
+def _joint(
+    m: mujoco.MjModel,
+    b: int,
+    names: list[str],
+    shift: np.ndarray,
+    joint_of: dict[int, int],
+) -> str:
+    """The ``<joint>`` that hangs body ``b`` from its parent: revolute at its hinge, else
+    fixed (``shift`` ``(nbody, 3)`` each body's hinge position [m])."""
+    p = m.body_parentid[b]
+    if p == 0:
+        raise RobotError(f"body {names[b]!r} hangs from the world; URDF export needs one tree")
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, m.body_quat[b])
+    xyz = m.body_pos[b] + mat.reshape(3, 3) @ shift[b] - shift[p]
+    origin = f'<origin xyz="{_v(xyz)}" rpy="{_v(_rpy(m.body_quat[b]))}"/>'
+    link = f"<parent link={quoteattr(names[p])}/><child link={quoteattr(names[b])}/>"
+    if b in joint_of:
+        j = joint_of[b]
+        lo, hi = m.jnt_range[j] if m.jnt_limited[j] else (-np.pi, np.pi)
+        return (
+            f'<joint name={quoteattr(m.joint(j).name)} type="revolute">{origin}{link}'
+            f'<axis xyz="{_v(m.jnt_axis[j])}"/>'
+            f'<limit lower="{lo:.9g}" upper="{hi:.9g}" effort="1000" velocity="1000"/>'
+            "</joint>"
         )
-        for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
-            if m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0:
-                continue  # visual only
-            xml = _geom(m, g, shift[b], meshes)
-            if xml is not None:
-                body.append(xml)
-                friction[b] = max(friction[b], float(m.geom_friction[g, 0]))
-        body.append("</link>")
-        out.append("".join(body))
-    for b in range(1, m.nbody):
-        if b == base:
-            continue
-        p = m.body_parentid[b]
-        if p == 0:
-            raise RobotError(f"body {names[b]!r} hangs from the world; URDF export needs one tree")
-        mat = np.zeros(9)
-        mujoco.mju_quat2Mat(mat, m.body_quat[b])
-        xyz = m.body_pos[b] + mat.reshape(3, 3) @ shift[b] - shift[p]
-        origin = f'<origin xyz="{_v(xyz)}" rpy="{_v(_rpy(m.body_quat[b]))}"/>'
-        link = f"<parent link={quoteattr(names[p])}/><child link={quoteattr(names[b])}/>"
-        if b in joint_of:
-            j = joint_of[b]
-            lo, hi = m.jnt_range[j] if m.jnt_limited[j] else (-np.pi, np.pi)
-            out.append(
-                f'<joint name={quoteattr(m.joint(j).name)} type="revolute">{origin}{link}'
-                f'<axis xyz="{_v(m.jnt_axis[j])}"/>'
-                f'<limit lower="{lo:.9g}" upper="{hi:.9g}" effort="1000" velocity="1000"/>'
-                "</joint>"
-            )
-        else:
-            fixed = quoteattr(names[b] + "_fixed")
-            out.append(f'<joint name={fixed} type="fixed">{origin}{link}</joint>')
-    out.append("</robot>")
-    moved = tuple(names[m.joint(mj).bodyid[0]] for mj in robot.mj_joints)
-    objs = {name: _obj(m, mid) for mid, name in meshes.items()}
-    return UrdfRobot("\n".join(out), ("", *names[1:]), names[base], moved, friction, objs)
+    fixed = quoteattr(names[b] + "_fixed")
+    return f'<joint name={fixed} type="fixed">{origin}{link}</joint>'
 
 
 def _obj(m: mujoco.MjModel, mid: int) -> str:

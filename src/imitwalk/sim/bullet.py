@@ -22,12 +22,13 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Sequence
 
+import mujoco
 import numpy as np
 import pybullet as pb
 
 from imitwalk.robots import Robot
 from imitwalk.robots.servos import actuator_kind, torque_limit
-from imitwalk.robots.urdf import urdf_file
+from imitwalk.robots.urdf import UrdfRobot, urdf_file
 from imitwalk.sim.servo import StablePD
 from imitwalk.sim.types import (
     Observation,
@@ -64,12 +65,42 @@ class BulletPlant:
         self.nq = m.nq
         self.client = c = pb.connect(pb.DIRECT)
         self.gravity = gravity(opt)
+        self.floor = self._make_floor()
+        self.body = pb.loadURDF(str(path), flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        joint = self._index_joints(u, m)
+        scale, kps = jitter_draws(opt, m.nbody, robot.joint_names)  # as MujocoPlant's
+        self._set_dynamics(m, u, scale)
+        self._make_servos(m, joint, kps)
+        self._imu = self._site(m, robot.gyro)
+        self._touch = [[self._site(m, n) for n in robot.foot_force[s]] for s in ("l", "r")]
+        self._soles = [self._site(m, robot.soles[s], sensor=False) for s in ("l", "r")]
+        self._torso = self._link_of_body[m.body(robot.torso).id]
+        self._all_dofs = list(range(pb.getNumJoints(self.body, physicsClientId=c)))
+        self._noise = np.random.default_rng(opt.seed + 7919)
+        self._cmd = robot.stand.copy()
+        self._queue = ServoQueue(self._cmd.copy(), opt.delay_steps(1.0 / self.dt))
+        self._steps = self._kicks = 0
+        self._accel = np.zeros(3)
+        self._imu_now: tuple[np.ndarray, ...] = (np.zeros(3), np.zeros(3), np.eye(3))  # (v, ω, R)
+        self.time = 0.0
+        self.fell = False
+        self.fall_time: float | None = None
+
+    # -- building ---------------------------------------------------------------
+    def _make_floor(self) -> int:
+        """Set gravity and the time step, and add the floor: its body id."""
+        c = self.client
         pb.setGravity(*self.gravity, physicsClientId=c)
         pb.setTimeStep(self.dt, physicsClientId=c)
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
-        self.floor = pb.createMultiBody(0, plane, physicsClientId=c)
-        pb.changeDynamics(self.floor, -1, lateralFriction=1.0, physicsClientId=c)
-        self.body = pb.loadURDF(str(path), flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        floor = pb.createMultiBody(0, plane, physicsClientId=c)
+        pb.changeDynamics(floor, -1, lateralFriction=1.0, physicsClientId=c)
+        return floor
+
+    def _index_joints(self, u: UrdfRobot, m: mujoco.MjModel) -> dict[str, int]:
+        """The loaded robot's joint index by MJCF joint name; sets ``_link_of_body`` (MuJoCo
+        body -> link) and releases the joints' default velocity motors."""
+        c = self.client
         link = {u.base: -1}
         joint = {}
         for i in range(pb.getNumJoints(self.body, physicsClientId=c)):
@@ -78,7 +109,12 @@ class BulletPlant:
             joint[info[1].decode()] = i
             pb.setJointMotorControl2(self.body, i, pb.VELOCITY_CONTROL, force=0, physicsClientId=c)
         self._link_of_body = [link.get(u.links[b]) for b in range(m.nbody)]
-        scale, kps = jitter_draws(opt, m.nbody, robot.joint_names)  # as MujocoPlant's
+        return joint
+
+    def _set_dynamics(self, m: mujoco.MjModel, u: UrdfRobot, scale: np.ndarray) -> None:
+        """Each link's mass and inertia (times ``scale`` ``(nbody,)``) and friction, and no
+        velocity damping."""
+        c, opt = self.client, self.options
         for b in range(1, m.nbody):
             mu = opt.friction if opt.friction is not None else u.friction[b]
             mass, inertia = m.body_mass[b] * scale[b], m.body_inertia[b] * scale[b]
@@ -93,6 +129,11 @@ class BulletPlant:
         # Bullet damps every multibody's velocities by default; MuJoCo does not. (Passed
         # with a link index, pybullet applies these to the base and drops the mass.)
         pb.changeDynamics(self.body, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=c)
+
+    def _make_servos(self, m: mujoco.MjModel, joint: dict[str, int], kps: np.ndarray) -> None:
+        """The role joints' servos (stiffness times ``kps`` ``(n,)``), and servos holding the
+        standing posture on other hinges with a position servo."""
+        robot = self.robot
         jid = [m.joint(j).id for j in robot.mj_joints]
         self._qadr = m.jnt_qposadr[jid]
         self._dof = [joint[j] for j in robot.mj_joints]
@@ -112,29 +153,16 @@ class BulletPlant:
         self._sign = robot.signs
         self._stand_qpos = robot.stand_qpos.copy()
 
-        def site(name: str, sensor: bool = True) -> tuple[int, np.ndarray, np.ndarray]:
-            """(link, position in it, half-size) of a sensor's site, or of a sole (a site,
-            else a body's origin)."""
-            if not sensor and name not in [m.site(i).name for i in range(m.nsite)]:
-                return self._link_of_body[m.body(name).id], np.zeros(3), np.zeros(3)
-            sid = m.sensor(name).objid[0] if sensor else m.site(name).id
-            link = self._link_of_body[m.site_bodyid[sid]]
-            return link, m.site_pos[sid].copy(), m.site_size[sid].copy()
-
-        self._imu = site(robot.gyro)
-        self._touch = [[site(n) for n in robot.foot_force[s]] for s in ("l", "r")]
-        self._soles = [site(robot.soles[s], sensor=False) for s in ("l", "r")]
-        self._torso = self._link_of_body[m.body(robot.torso).id]
-        self._all_dofs = list(range(pb.getNumJoints(self.body, physicsClientId=c)))
-        self._noise = np.random.default_rng(opt.seed + 7919)
-        self._cmd = robot.stand.copy()
-        self._queue = ServoQueue(self._cmd.copy(), opt.delay_steps(1.0 / self.dt))
-        self._steps = self._kicks = 0
-        self._accel = np.zeros(3)
-        self._imu_now: tuple[np.ndarray, ...] = (np.zeros(3), np.zeros(3), np.eye(3))  # (v, ω, R)
-        self.time = 0.0
-        self.fell = False
-        self.fall_time: float | None = None
+    def _site(
+        self, m: mujoco.MjModel, name: str, sensor: bool = True
+    ) -> tuple[int, np.ndarray, np.ndarray]:
+        """(link, position in it, half-size) of a sensor's site, or of a sole (a site,
+        else a body's origin)."""
+        if not sensor and name not in [m.site(i).name for i in range(m.nsite)]:
+            return self._link_of_body[m.body(name).id], np.zeros(3), np.zeros(3)
+        sid = m.sensor(name).objid[0] if sensor else m.site(name).id
+        link = self._link_of_body[m.site_bodyid[sid]]
+        return link, m.site_pos[sid].copy(), m.site_size[sid].copy()
 
     def __del__(self) -> None:
         with contextlib.suppress(Exception):  # already gone at interpreter exit

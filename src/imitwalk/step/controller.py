@@ -42,6 +42,13 @@ from imitwalk.step.odometry import LegOdometry, Pose2D, StepCommand
 from imitwalk.step.planner import plan_step
 from imitwalk.step.schedule import LATE, MAX_STEP_YAW, SETTLE, SHIFT
 from imitwalk.step.style import GaitStyle
+from imitwalk.step.support import (
+    other_side,
+    press_point,
+    weight_shares,
+    within_support,
+    zmp_box,
+)
 from imitwalk.step.swing import SwingFoot
 
 __all__ = ["TOUCHDOWN_LOAD", "SteppingController", "TickLog"]
@@ -77,10 +84,6 @@ class TickLog:
 def _smooth(x: float) -> float:
     x = min(max(x, 0.0), 1.0)
     return x * x * x * (x * (6.0 * x - 15.0) + 10.0)
-
-
-def _other(side: str) -> str:
-    return "l" if side == "r" else "r"
 
 
 class SteppingController:
@@ -185,11 +188,29 @@ class SteppingController:
         )
 
     def __call__(self, k: int, obs: Observation) -> np.ndarray:
+        """The joint targets ``(n,)`` [rad] for tick ``k`` (the steps of the module doc)."""
         if k == 0 or not self._started:
             self._start(obs)
-        dt, g = self.dt, self.gains
         e = self.est.update(obs, self.zmp)
         self._com, self._heading = e.com[:2], e.heading
+        zmp_plan, xi_ref = self._plan_step(e)
+        self._command_body(e, zmp_plan, xi_ref)
+        self.land_yaw = self._landing_yaw(e)
+        if self.single:
+            self.swing.advance(
+                self.t_phase, self.ss, self.landing, self.land_yaw, e.swing.pos, self.dt, e.slope
+            )
+        q = self._joints(e)
+        if self.log:
+            self._record(k, e, xi_ref)
+        self.t_phase += self.dt
+        self._advance(e)
+        return q
+
+    def _plan_step(self, e: BodyEstimate) -> tuple[np.ndarray, np.ndarray]:
+        """Step 2: where and when the swing foot lands (``self.landing``, ``self.ss``), and
+        the planned ZMP now and the DCM reference ``ξ_ref``, each ``(2,)`` [m]."""
+        g = self.gains
         side = 1.0 if self.stance == "l" else -1.0
         gait = self.nominal.gait(self.steps + 1, self.command.stride)
         zmp_plan, heel, toe, ds_left = self._zmp_plan(e)
@@ -209,7 +230,7 @@ class SteppingController:
                 swing_at=self.swing.pose.pos[:2],
                 nominal_step=nominal,
                 offset=offset,
-                zmp_box=self._zmp_box(zmp_plan, toe),
+                zmp_box=zmp_box(self.half, g.support, g.plan_support, zmp_plan, toe),
             )
             self.landing, self.ss = choice.landing, self.t_phase + choice.remaining
             zmp_plan = zmp_plan + choice.zmp_shift
@@ -221,62 +242,52 @@ class SteppingController:
             xi_ref = (
                 dcm_before(xi_td, zmp_plan, heel, ds_left, self.omega) if ds_left > 0 else xi_td
             )
-        # the commanded body: a pendulum kept on the DCM reference by its ZMP ...
+        return zmp_plan, xi_ref
+
+    def _command_body(self, e: BodyEstimate, zmp_plan: np.ndarray, xi_ref: np.ndarray) -> None:
+        """Step 3: the commanded body, a pendulum kept on the DCM reference ``xi_ref`` by its
+        ZMP, and the ankles' share of the balance."""
+        dt, g = self.dt, self.gains
         xi_cmd = self.c_ref + self.v_ref / self.omega
-        self.zmp = self._support(zmp_plan + g.dcm * (xi_cmd - xi_ref))
+        self.zmp = within_support(
+            zmp_plan + g.dcm * (xi_cmd - xi_ref),
+            self.half,
+            g.support,
+            self.single,
+            self.trail.pos[:2],
+        )
         self.c_ref, self.v_ref = lipm_step(self.c_ref, self.v_ref, self.zmp, dt, self.omega)
         self.c_ref = self.c_ref + g.follow * (e.com[:2] - self.c_ref)
         self.v_ref = self.v_ref + g.follow * (e.com_vel - self.v_ref)
         # ... and the measured DCM's error from it shifts the ZMP through the ankles
         self.ankle_zmp = g.ankle * (e.dcm - xi_cmd)
-        # the next foot's heading: the heading error turned back, and the turn commanded
+
+    def _landing_yaw(self, e: BodyEstimate) -> float:
+        """The next foot's heading [rad]: the heading error turned back, and the turn
+        commanded fed forward, within :data:`~imitwalk.step.schedule.MAX_STEP_YAW`."""
+        g = self.gains
         err = self.command.heading - e.heading
         if abs(err) > np.pi:  # the measured heading is wrapped to (-pi, pi]
             err = (err + np.pi) % (2 * np.pi) - np.pi
-        turn = g.heading * err + (1.0 - g.heading) * self.command.turn  # a turn fed forward
-        self.land_yaw = float(min(max(turn, -MAX_STEP_YAW), MAX_STEP_YAW))
-        if self.single:
-            self.swing.advance(
-                self.t_phase, self.ss, self.landing, self.land_yaw, e.swing.pos, dt, e.slope
-            )
-        q = self._joints(e)
-        if self.log:
-            self.ticks.append(
-                TickLog(
-                    k * dt,
-                    self.stance,
-                    self.single,
-                    self.steps,
-                    e.dcm.copy(),
-                    xi_ref.copy(),
-                    self.zmp.copy(),
-                    self.c_ref.copy(),
-                    self.landing.copy(),
-                    self.ss,
-                )
-            )
-        self.t_phase += dt
-        self._advance(e)
-        return q
+        turn = g.heading * err + (1.0 - g.heading) * self.command.turn
+        return float(min(max(turn, -MAX_STEP_YAW), MAX_STEP_YAW))
 
-    def _zmp_box(self, now: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The ZMP shifts that keep the rest of the single support's ZMP plan (from ``now``
-        to ``end``) within the stance sole shrunk by ``support``."""
-        lim = self.half * self.gains.support * self.gains.plan_support
-        lo = -lim - np.minimum(now, end)
-        hi = lim - np.maximum(now, end)
-        return np.minimum(lo, 0.0), np.maximum(hi, 0.0)
-
-    def _support(self, p: np.ndarray) -> np.ndarray:
-        """``p`` kept within the support: the stance sole shrunk by ``support``, or in
-        double support the box spanning both soles."""
-        lim = self.half * self.gains.support
-        if self.single:
-            return np.minimum(np.maximum(p, -lim), lim)
-        other = self.trail.pos[:2]
-        lo = np.minimum(-lim, other - lim)
-        hi = np.maximum(lim, other + lim)
-        return np.minimum(np.maximum(p, lo), hi)
+    def _record(self, k: int, e: BodyEstimate, xi_ref: np.ndarray) -> None:
+        """Keep tick ``k``'s :class:`TickLog`."""
+        self.ticks.append(
+            TickLog(
+                k * self.dt,
+                self.stance,
+                self.single,
+                self.steps,
+                e.dcm.copy(),
+                xi_ref.copy(),
+                self.zmp.copy(),
+                self.c_ref.copy(),
+                self.landing.copy(),
+                self.ss,
+            )
+        )
 
     def _joints(self, e: BodyEstimate) -> np.ndarray:
         st, g = self.style, self.gains
@@ -286,29 +297,16 @@ class SteppingController:
         else:
             height = self.pelvis_z
         other = self.swing.command() if self.single else self.trail
-        shares = self._shares()
-        loads = {side: (w, self._press(side)) for side, w in shares.items() if w > 0.0}
+        shares = weight_shares(self.stance, self.single, self.zmp, self.trail.pos[:2])
+        loads = {
+            side: (w, press_point(side, self.stance, self.single, self.zmp, self.trail.pos))
+            for side, w in shares.items()
+            if w > 0.0
+        }
         com = self.c_ref + g.lead * self.v_ref
         return self.joints.solve(
             self.stance, com, height, other, self._phase(), loads, self.ankle_zmp
         )
-
-    def _press(self, side: str) -> np.ndarray:
-        """Where ``side``'s sole presses ``(3,)`` [m] (stance frame): the stance sole at
-        the commanded ZMP in single support, each sole's centre in double support."""
-        if side == self.stance:
-            return np.array([*self.zmp, 0.0]) if self.single else np.zeros(3)
-        return self.trail.pos.copy()
-
-    def _shares(self) -> dict[str, float]:
-        """The robot's weight on each sole, as planned: all on the stance sole in single
-        support; in double support shared by where the commanded ZMP lies between them."""
-        other = _other(self.stance)
-        if self.single:
-            return {self.stance: 1.0, other: 0.0}
-        d = self.trail.pos[:2]
-        w = float(min(max(np.dot(self.zmp, d) / max(np.dot(d, d), 1e-9), 0.0), 1.0))
-        return {self.stance: 1.0 - w, other: w}
 
     @property
     def phase(self) -> float:
@@ -342,7 +340,7 @@ class SteppingController:
         late = self.t_phase > self.ss + LATE * st.step_time
         if not (landed or late):
             return
-        new = _other(self.stance)
+        new = other_side(self.stance)
         land = FootPose(e.swing.pos.copy(), e.swing.yaw)
         self.odometry.touchdown(land.pos[:2], e.heading)
         rot = rot_z(-land.yaw)

@@ -31,7 +31,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -197,98 +197,147 @@ def learn_step(
     Raises:
         RunError: ``resume`` without a checkpoint, or with other settings.
     """
-    from cmaes import CMA
-
     say = progress or (lambda _msg: None)
     styles = list(style) if isinstance(style, list) else [style]
     rd = RunDir(run_dir)
     rd.path.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     start = start or StepGains()
-    log: list[dict] = []
+    opt, log, spent, wall = _optimiser(rd, cfg, start, resume, say)
+    t0 -= wall
+    for gen in range(len(log), cfg.generations):
+        spent += _generation(opt, gen, start, robot, styles, cfg, protocol, log, say)
+        _save(rd, cfg, opt, log, spent, time.perf_counter() - t0)
+    kept, final, spent = _final_choice(log, start, robot, styles, cfg, protocol, spent, say)
+    return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)
+
+
+def _optimiser(
+    rd: RunDir, cfg: StepLearnConfig, start: StepGains, resume: bool, say: Callable[[str], None]
+) -> tuple[Any, list[dict], float, float]:
+    """The CMA-ES optimiser, the generations' log, the simulated seconds spent [s] and the
+    wall time spent [s]: a fresh search from ``start``, or the checkpoint's (``resume``).
+
+    Raises:
+        RunError: ``resume`` without a checkpoint, or with other settings.
+    """
+    from cmaes import CMA
+
     if resume and rd.exists("cma.pkl"):
         saved = _checkpoint(rd)
         if saved["config"] != cfg.to_dict():
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
-        opt, log, spent, wall = saved["cma"], saved["log"], saved["sim_seconds"], saved["wall"]
-        t0 -= wall
-        say(f"learn: resuming after generation {len(log)}")
-    elif resume:
+        say(f"learn: resuming after generation {len(saved['log'])}")
+        return saved["cma"], saved["log"], saved["sim_seconds"], saved["wall"]
+    if resume:
         raise RunError(f"nothing to resume in {rd.path}: no cma.pkl")
-    else:
-        x0 = start.vector(cfg.names)
-        bounds = np.tile([0.0, 1.0], (len(cfg.names), 1))
-        opt = CMA(
-            mean=x0, sigma=cfg.sigma, bounds=bounds, population_size=cfg.population, seed=cfg.seed
-        )
-        spent = 0.0
-    for gen in range(len(log), cfg.generations):
-        # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
-        # random state, and a resumed run must draw what an uninterrupted one would
-        opt.reseed_rng(cfg.seed * 100_003 + gen)
-        xs = [opt.ask() for _ in range(opt.population_size)]
-        cands = [start.with_vector(cfg.names, x) for x in xs]
-        draws = _robots(protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
-        scores = _walk_all(cands, draws, robot, styles, cfg)
-        costs = [mean_cost(s) for s in scores]
-        spent += sum(r.seconds for s in scores for r in s)
-        opt.tell(list(zip(xs, costs, strict=True)))
-        k = int(np.argmin(costs))
-        falls = [sum(r.fell for r in s) for s in scores]
-        log.append(
-            {
-                "generation": gen + 1,
-                "best_cost": costs[k],
-                "mean_cost": float(np.mean(costs)),
-                "best_falls": falls[k],
-                "robots": cfg.robots,
-                "best_gains": cands[k].to_dict(),
-            }
-        )
-        say(
-            f"learn: generation {gen + 1}/{cfg.generations}: best cost {costs[k]:.3f} "
-            f"({falls[k]}/{cfg.robots} fell), mean {np.mean(costs):.3f}"
-        )
-        state = {
-            "config": cfg.to_dict(),
-            "cma": opt,
-            "log": log,
-            "sim_seconds": spent,
-            "wall": time.perf_counter() - t0,
+    x0 = start.vector(cfg.names)
+    bounds = np.tile([0.0, 1.0], (len(cfg.names), 1))
+    opt = CMA(
+        mean=x0, sigma=cfg.sigma, bounds=bounds, population_size=cfg.population, seed=cfg.seed
+    )
+    return opt, [], 0.0, 0.0
+
+
+def _generation(
+    opt: Any,
+    gen: int,
+    start: StepGains,
+    robot: Robot,
+    styles: list[GaitStyle],
+    cfg: StepLearnConfig,
+    protocol: Protocol,
+    log: list[dict],
+    say: Callable[[str], None],
+) -> float:
+    """One generation ``gen`` (from 0): its candidates walk fresh training robots, the
+    optimiser is told their costs, and ``log`` gains its line. Returns the simulated
+    seconds walked [s]."""
+    # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
+    # random state, and a resumed run must draw what an uninterrupted one would
+    opt.reseed_rng(cfg.seed * 100_003 + gen)
+    xs = [opt.ask() for _ in range(opt.population_size)]
+    cands = [start.with_vector(cfg.names, x) for x in xs]
+    draws = _robots(protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
+    scores = _walk_all(cands, draws, robot, styles, cfg)
+    costs = [mean_cost(s) for s in scores]
+    walked = sum(r.seconds for s in scores for r in s)
+    opt.tell(list(zip(xs, costs, strict=True)))
+    k = int(np.argmin(costs))
+    falls = [sum(r.fell for r in s) for s in scores]
+    log.append(
+        {
+            "generation": gen + 1,
+            "best_cost": costs[k],
+            "mean_cost": float(np.mean(costs)),
+            "best_falls": falls[k],
+            "robots": cfg.robots,
+            "best_gains": cands[k].to_dict(),
         }
-        # mypy cannot infer a lambda with a default argument against a one-argument Callable
-        atomic_write(rd.file("cma.pkl"), lambda tmp, s=state: tmp.write_bytes(pickle.dumps(s)))  # type: ignore[misc]
-        rd.write_log(log)
+    )
+    say(
+        f"learn: generation {gen + 1}/{cfg.generations}: best cost {costs[k]:.3f} "
+        f"({falls[k]}/{cfg.robots} fell), mean {np.mean(costs):.3f}"
+    )
+    return walked
+
+
+def _save(
+    rd: RunDir, cfg: StepLearnConfig, opt: Any, log: list[dict], spent: float, wall: float
+) -> None:
+    """The checkpoint (``cma.pkl``: the optimiser, the log, the simulated and wall seconds
+    spent [s]) and ``log.jsonl``, each written whole."""
+    state = {"config": cfg.to_dict(), "cma": opt, "log": log, "sim_seconds": spent, "wall": wall}
+    blob = pickle.dumps(state)
+    atomic_write(rd.file("cma.pkl"), lambda tmp: tmp.write_bytes(blob))
+    rd.write_log(log)
+
+
+def _final_choice(
+    log: list[dict],
+    start: StepGains,
+    robot: Robot,
+    styles: list[GaitStyle],
+    cfg: StepLearnConfig,
+    protocol: Protocol,
+    spent: float,
+    say: Callable[[str], None],
+) -> tuple[StepGains, dict, float]:
+    """The gains kept, each finalist's walk on the final robots, and ``spent`` plus what
+    they walked [s]: the start and each generation's best walk ``cfg.final_robots``
+    robots; a generation's best replaces the start only if it fells at least
+    :data:`KEEP_MARGIN` fewer (without final robots: the best cost of the generations)."""
     finalists = {"start": start}
     for entry in log:
         finalists[f"generation {entry['generation']}"] = StepGains.from_dict(entry["best_gains"])
     final: dict = {}
     kept = StepGains.from_dict(min(log, key=lambda e: e["best_cost"])["best_gains"])
-    if cfg.final_robots:
-        long = replace(cfg, seconds=cfg.final_seconds)
-        draws = _robots(protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.final_seconds)
-        names = list(finalists)
-        scores = _walk_all([finalists[n] for n in names], draws, robot, styles, long)
-        spent += sum(r.seconds for s in scores for r in s)
-        final = {
-            n: {"cost": mean_cost(s), "falls": int(sum(r.fell for r in s))}
-            for n, s in zip(names, scores, strict=True)
-        }
-        bar = final["start"]["falls"] - KEEP_MARGIN
-        better = [n for n in names[1:] if final[n]["falls"] <= bar]
-        best = min(better, key=lambda n: (final[n]["cost"], names.index(n))) if better else "start"
-        kept = finalists[best]
-        fell = f"{final[best]['falls']}/{cfg.final_robots}"
-        say(f"learn: kept {best} ({fell} fell on the final robots)")
-        # the nominal robot (no factor drawn) walks the kept gains once: a robot or clip
-        # the stepping gait cannot walk at all is told so
-        nominal = protocol.only(()).draw(FINAL_FIRST, robot, seconds=cfg.final_seconds)
-        walk = _walk_all([kept], [nominal], robot, styles, long)[0][0]
-        spent += walk.seconds
-        if walk.fell:
-            say(
-                "learn: warning: the kept gains fall on the nominal robot at "
-                f"{walk.fall_time_s:.1f} s; for this robot or clip try `--variant extended` "
-                "(the per-tick learner)"
-            )
-    return StepLearnResult(kept, log, final, spent, time.perf_counter() - t0)
+    if not cfg.final_robots:
+        return kept, final, spent
+    long = replace(cfg, seconds=cfg.final_seconds)
+    draws = _robots(protocol, robot, FINAL_FIRST, cfg.final_robots, cfg.final_seconds)
+    names = list(finalists)
+    scores = _walk_all([finalists[n] for n in names], draws, robot, styles, long)
+    spent += sum(r.seconds for s in scores for r in s)
+    final = {
+        n: {"cost": mean_cost(s), "falls": int(sum(r.fell for r in s))}
+        for n, s in zip(names, scores, strict=True)
+    }
+    bar = final["start"]["falls"] - KEEP_MARGIN
+    better = [n for n in names[1:] if final[n]["falls"] <= bar]
+    best = min(better, key=lambda n: (final[n]["cost"], names.index(n))) if better else "start"
+    kept = finalists[best]
+    fell = f"{final[best]['falls']}/{cfg.final_robots}"
+    say(f"learn: kept {best} ({fell} fell on the final robots)")
+    # the nominal robot (no factor drawn) walks the kept gains once: a robot or clip
+    # the stepping gait cannot walk at all is told so
+    nominal = protocol.only(()).draw(FINAL_FIRST, robot, seconds=cfg.final_seconds)
+    walk = _walk_all([kept], [nominal], robot, styles, long)[0][0]
+    spent += walk.seconds
+    if walk.fell:
+        say(
+            "learn: warning: the kept gains fall on the nominal robot at "
+            f"{walk.fall_time_s:.1f} s; for this robot or clip try `--variant extended` "
+            "(the per-tick learner)"
+        )
+    return kept, final, spent

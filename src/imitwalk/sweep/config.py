@@ -132,18 +132,7 @@ def load_sweep(path: str | Path) -> SweepConfig:
     """
     p = Path(path)
     where = str(p)
-    if not p.is_file():
-        raise ConfigError(f"sweep file not found: {p}")
-    try:
-        text = p.read_text(encoding="utf-8")
-        d = tomllib.loads(text) if p.suffix.lower() == ".toml" else json.loads(text)
-    except (UnicodeDecodeError, ValueError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"{where} is not a sweep's JSON or TOML: {exc}") from None
-    if not isinstance(d, dict):
-        raise ConfigError(f"{where}: a sweep is a table of keys ({', '.join(KEYS)})")
-    for key in d:
-        if key not in KEYS:
-            raise unknown_name("sweep key", key, KEYS, ConfigError)
+    d = _read_table(p, where)
     base = p.resolve().parent
     kw: dict[str, Any] = {"source": str(p.resolve())}
     if "clips" in d:
@@ -157,37 +146,73 @@ def load_sweep(path: str | Path) -> SweepConfig:
             for r in _strings(d, "robots", where)
         )
     if "settings" in d:
-        s = d["settings"]
-        ok = (
-            isinstance(s, list)
-            and s
-            and all(isinstance(x, list) and all(isinstance(y, str) for y in x) for x in s)
-        )
-        if not ok:
-            raise ConfigError(f'{where}: settings must be a list of lists of "key=value"')
-        kw["settings"] = tuple(tuple(x) for x in s)
+        kw["settings"] = _settings(d["settings"], where)
     if "seeds" in d:
-        s = d["seeds"]
-        if not isinstance(s, list) or not s or not all(type(x) is int and x >= 0 for x in s):
-            raise ConfigError(f"{where}: seeds must be a non-empty list of integers >= 0")
-        kw["seeds"] = tuple(s)
+        kw["seeds"] = _seeds(d["seeds"], where)
     if "protocol" in d:
-        if not isinstance(d["protocol"], str):
-            raise ConfigError(f"{where}: protocol must be a protocol's name or file")
-        proto = d["protocol"]
-        kw["protocol"] = (
-            _resolve(proto, base, "protocol", where) if proto.endswith(".json") else proto
-        )
+        kw["protocol"] = _protocol(d["protocol"], base, where)
     if "judge_robots" in d:
-        n = d["judge_robots"]
-        if type(n) is not int or n < 1:
-            raise ConfigError(f"{where}: judge_robots must be an integer >= 1")
-        kw["judge_robots"] = n
+        kw["judge_robots"] = _judge_robots(d["judge_robots"], where)
     if "seconds" in d:
-        t = d["seconds"]
-        if isinstance(t, bool) or not isinstance(t, int | float) or not t > 0:
-            raise ConfigError(f"{where}: seconds must be a number > 0")
-        kw["seconds"] = float(t)
+        kw["seconds"] = _seconds(d["seconds"], where)
     cfg = SweepConfig(**kw)
     _check(cfg, where)
     return cfg
+
+
+def _read_table(p: Path, where: str) -> dict:
+    """The sweep file ``p``'s table of keys (TOML by its suffix, else JSON), every key one
+    of :data:`KEYS`."""
+    if not p.is_file():
+        raise ConfigError(f"sweep file not found: {p}")
+    try:
+        text = p.read_text(encoding="utf-8")
+        d = tomllib.loads(text) if p.suffix.lower() == ".toml" else json.loads(text)
+    except (UnicodeDecodeError, ValueError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"{where} is not a sweep's JSON or TOML: {exc}") from None
+    if not isinstance(d, dict):
+        raise ConfigError(f"{where}: a sweep is a table of keys ({', '.join(KEYS)})")
+    for key in d:
+        if key not in KEYS:
+            raise unknown_name("sweep key", key, KEYS, ConfigError)
+    return d
+
+
+def _settings(s: Any, where: str) -> tuple[tuple[str, ...], ...]:
+    """The ``settings`` key: a non-empty list of lists of ``"key=value"``."""
+    ok = (
+        isinstance(s, list)
+        and s
+        and all(isinstance(x, list) and all(isinstance(y, str) for y in x) for x in s)
+    )
+    if not ok:
+        raise ConfigError(f'{where}: settings must be a list of lists of "key=value"')
+    return tuple(tuple(x) for x in s)
+
+
+def _seeds(s: object, where: str) -> tuple[int, ...]:
+    """The ``seeds`` key: a non-empty list of integers >= 0."""
+    if not isinstance(s, list) or not s or not all(type(x) is int and x >= 0 for x in s):
+        raise ConfigError(f"{where}: seeds must be a non-empty list of integers >= 0")
+    return tuple(s)
+
+
+def _protocol(proto: object, base: Path, where: str) -> str:
+    """The ``protocol`` key: a protocol's name, or a ``.json`` file relative to ``base``."""
+    if not isinstance(proto, str):
+        raise ConfigError(f"{where}: protocol must be a protocol's name or file")
+    return _resolve(proto, base, "protocol", where) if proto.endswith(".json") else proto
+
+
+def _judge_robots(n: object, where: str) -> int:
+    """The ``judge_robots`` key: an integer >= 1."""
+    if type(n) is not int or n < 1:
+        raise ConfigError(f"{where}: judge_robots must be an integer >= 1")
+    return n
+
+
+def _seconds(t: object, where: str) -> float:
+    """The ``seconds`` key: a number > 0 [s]."""
+    if isinstance(t, bool) or not isinstance(t, int | float) or not t > 0:
+        raise ConfigError(f"{where}: seconds must be a number > 0")
+    return float(t)
