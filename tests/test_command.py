@@ -282,7 +282,7 @@ def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     from imitwalk.balance.tickconfig import TickLearnConfig
     from imitwalk.balance.ticklearn import learn_tick
     from imitwalk.config import apply_overrides
-    from imitwalk.judge.verdict import JudgeJob, run_controller
+    from imitwalk.judge.verdict import RunController
     from imitwalk.sim.protocol import load_protocol
     from tests.conftest import TICK
 
@@ -295,18 +295,8 @@ def test_learn_and_evaluate_a_turning_walk(tmp_path, robot, template):
     for mode in ("learned", "feedback", "open_loop"):
         for seed in (0, 1):
             d = protocol.draw(seed, robot, seconds=10.0)
-            job = JudgeJob(
-                str(tmp_path / "run"),
-                robot,
-                mode,
-                seed,
-                d.options,
-                d.furthest,
-                10.0,
-                None,
-                protocol.engine,
-            )
-            r = run_controller(job).metrics
+            run = RunController(str(tmp_path / "run"), mode)
+            r = run.walk(robot, d.options, 10.0, protocol.engine)
             assert r.commanded_turn_deg > 20.0  # ~4.8° per cycle for 10 s
             if not r.fell:  # it follows the turn: what is left is a drift, not the turn
                 assert abs(r.yaw_drift_deg) < r.commanded_turn_deg / 2

@@ -154,7 +154,7 @@ def test_a_verdict_file_of_another_layout_is_a_one_line_error():
 
 
 def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_run, robot):
-    from imitwalk.judge.verdict import JudgeJob, run_controller
+    from imitwalk.judge.verdict import RunController
 
     protocol = load_protocol("hard")
     out = judge_protocol(
@@ -174,11 +174,8 @@ def test_falls_explained_name_the_factors_whose_removal_alone_saves_them(tick_ru
     for factor in protocol.factors:
         rest = protocol.only([f for f in protocol.factors if f != factor])
         d = rest.draw(seed, robot, seconds=SECONDS)
-        job = JudgeJob(
-            str(tick_run), robot, "fixed", seed, d.options, None, SECONDS, None, "mujoco"
-        )
-        walk = run_controller(job)
-        assert walk.metrics.fell == (factor not in saved[seed]), factor
+        walk = RunController(str(tick_run), "fixed").walk(robot, d.options, SECONDS, "mujoco")
+        assert walk.fell == (factor not in saved[seed]), factor
     back = ProtocolVerdict.from_dict(json.loads(json.dumps(out.to_dict())))
     assert back == out
     # verdicts written before falls could be explained still load
@@ -206,3 +203,21 @@ def test_the_reports_table_lists_the_explained_falls(judged):
     assert falling and "one factor alone back to nominal" in html
     for name in falling:
         assert f"<li>{name}: pushes {sides[name].falls}; by no single factor: 0</li>" in html
+
+
+def test_any_controller_is_judged_on_a_protocols_robots(tick_run, robot):
+    """judge_controllers takes controllers, not a run folder: a run's controller judged
+    through it is the same verdict as through judge_protocol, beside one of the caller's
+    own (a RunController at another scale), on the same robots."""
+    from imitwalk.judge.verdict import RunController, judge_controllers
+
+    protocol = load_protocol("eval")
+    by_run = judge_protocol(tick_run, robot, protocol, 3, 4.0, ("fixed",), workers=1)
+    mine = {
+        "fixed": RunController(str(tick_run), "fixed", by_run.settings.scale),
+        "slower": RunController(str(tick_run), "fixed", 0.8),
+    }
+    out = judge_controllers(mine, robot, protocol, 3, 4.0, by_run.settings.scale, workers=1)
+    assert out.controllers["fixed"] == by_run.controllers["fixed"]
+    assert out.settings.controllers == ("fixed", "slower")
+    assert [r.seed for r in out.controllers["slower"].per_seed] == [0, 1, 2]

@@ -17,11 +17,10 @@ SECONDS = 30.0
 def test_a_robot_that_falls_at_once_scores_about_zero(tick_run, robot, kick):
     """Kicked over at the start (``t`` [s], Δv [m/s]). Over the 0.5 mm commanded before a fall
     at 1.6 s, the 0.39 m the torso fell backwards read as a progress of -754."""
-    from imitwalk.judge.verdict import JudgeJob, load_run, run_controller
+    from imitwalk.judge.verdict import RunController, load_run
 
     options = SimOptions(pushes=(kick,))
-    job = JudgeJob(str(tick_run), robot, "fixed", 0, options, None, SECONDS, None, "mujoco")
-    m = run_controller(job).metrics
+    m = RunController(str(tick_run), "fixed").walk(robot, options, SECONDS, "mujoco")
     assert m.fell and m.fall_time_s < 2.5
     lr = load_run(str(tick_run))
     whole = lr.ref.expected_distance(lr.scale, SECONDS)  # [m]
@@ -32,10 +31,9 @@ def test_a_robot_that_falls_at_once_scores_about_zero(tick_run, robot, kick):
 
 
 def test_a_walk_that_does_not_fall_is_judged_as_before(tick_run, robot):
-    from imitwalk.judge.verdict import JudgeJob, load_run, run_controller
+    from imitwalk.judge.verdict import RunController, load_run
 
-    job = JudgeJob(str(tick_run), robot, "fixed", 0, SimOptions(), None, 4.0, None, "mujoco")
-    m = run_controller(job).metrics
+    m = RunController(str(tick_run), "fixed").walk(robot, SimOptions(), 4.0, "mujoco")
     lr = load_run(str(tick_run))
     assert not m.fell
     expected = lr.ref.expected_distance(lr.scale, m.seconds)

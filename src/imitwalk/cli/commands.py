@@ -15,7 +15,6 @@ if TYPE_CHECKING:
     from imitwalk.learning.refchoice import Choice
     from imitwalk.mocap import Motion
     from imitwalk.retarget import Reference, RetargetConfig
-    from imitwalk.retarget.search import Walker
     from imitwalk.robots import Robot
     from imitwalk.runs import LearnSummary, RunDir
 
@@ -62,8 +61,9 @@ def retarget(args: argparse.Namespace) -> int:
 
 def search_report(gen: int, total: int, score: float, params: dict) -> None:
     """Progress of the reference search (:mod:`imitwalk.retarget.search`)."""
-    shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
-    progress(f"  search generation {gen}/{total}: best score {score:.3f} ({shown})")
+    from imitwalk.retarget.search import search_line
+
+    progress(search_line(gen, total, score, params))
 
 
 def playback(args: argparse.Namespace) -> int:
@@ -105,7 +105,7 @@ def _with_command(cfg: RetargetConfig, args: argparse.Namespace) -> RetargetConf
 
 
 def learn(args: argparse.Namespace) -> int:
-    from imitwalk.learning.refchoice import learn_clip
+    from imitwalk.learning.jointspace import learn_joint_space
     from imitwalk.retarget import Reference
     from imitwalk.runs import RunDir
 
@@ -125,15 +125,12 @@ def learn(args: argparse.Namespace) -> int:
     elif args.reference:
         ref = Reference.load(args.reference)
     else:
-        motion = _motion(args, robot)
-        rcfg = _with_command(rcfg, args)
-        make_reference = _reference_maker(motion, robot, rcfg, args)
-        if args.variant != "faithful" and cfg.choice.robots and rcfg.searches:
-            summary, choice = learn_clip(
-                make_reference, robot, cfg, args.out, args.resume, progress
-            )
-            return _learned(summary, args, rd, choice)
-        ref = make_reference()
+        motion, rcfg = _motion(args, robot), _with_command(rcfg, args)
+        named = recorded_robot(args)
+        summary, choice = learn_joint_space(
+            motion, robot, args.out, cfg, rcfg, args.resume, progress, named
+        )
+        return _learned(summary, args, rd, choice)
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
     return _learned(summary, args, rd)
@@ -192,22 +189,6 @@ def _retarget_config(rt_set: list[str], given: bool) -> RetargetConfig:
         unused = ", ".join(f"retarget.{i}" for i in rt_set)
         progress(f"learn: {unused}: not used, the reference is given as it is")
     return rcfg
-
-
-def _reference_maker(
-    motion: Motion, robot: Robot, rcfg: RetargetConfig, args: argparse.Namespace
-) -> Callable[..., Reference]:
-    """``make_reference(walker=None)``: ``motion`` retargeted to ``robot`` by ``rcfg``, its
-    search walking candidates under ``walker`` (``None``: open loop)."""
-    from imitwalk.retarget import retarget as do_retarget
-
-    def make_reference(walker: Walker | None = None) -> Reference:
-        progress(f"learn: retargeting {motion.source}")
-        res = do_retarget(motion, robot, rcfg, search_report, walker=walker)
-        progress(f"  cycles: {res.template.meta['cycles_report']}")
-        return _named(res.reference, args)
-
-    return make_reference
 
 
 def _variant(args: argparse.Namespace) -> str:

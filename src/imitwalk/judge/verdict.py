@@ -1,20 +1,23 @@
-"""Judging a run on a robustness protocol: every controller on the same robots.
+"""Judging controllers on a robustness protocol: every controller on the same robots.
 
-:func:`judge_protocol` draws ``seeds`` robots from a :class:`~imitwalk.sim.protocol.Protocol`
-and walks each controller the run can build on every one of them, for ``seconds``
-from standing. Per controller it reports survival with its 95 % Wilson interval,
-distance, speed and mean |yaw| drift, and the falls broken down by the factor each
-robot drew furthest from nominal (and, if asked, by the factors whose removal alone
-saves it: :mod:`imitwalk.judge.explain`); every controller is compared with open loop
-on the same robots by the paired McNemar test. Robot ``s`` is the same robot whatever
-the controller, so the comparison is paired.
+:func:`judge_controllers` draws ``seeds`` robots from a
+:class:`~imitwalk.sim.protocol.Protocol` (the robot population) and walks each
+controller (anything :class:`Judged`: it walks a robot and measures the walk) on every
+one of them, for ``seconds`` from standing; :func:`judge_protocol` does so for the
+controllers a run folder can build (:class:`RunController`). Per controller it reports
+survival with its 95 % Wilson interval, distance, speed and mean |yaw| drift, and the
+falls broken down by the factor each robot drew furthest from nominal (and, if asked, by
+the factors whose removal alone saves it: :mod:`imitwalk.judge.explain`); every
+controller is compared with open loop on the same robots by the paired McNemar test.
+Robot ``s`` is the same robot whatever the controller, so the comparison is paired.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol as Interface
 
 import numpy as np
 
@@ -36,7 +39,25 @@ from imitwalk.sim.metrics import WalkMetrics, walk_metrics
 from imitwalk.sim.protocol import Protocol, RobotDraw
 from imitwalk.sim.types import SimOptions
 
-__all__ = ["JudgeJob", "RobotWalk", "judge_protocol", "run_controller"]
+__all__ = [
+    "JudgeJob",
+    "Judged",
+    "RobotWalk",
+    "RunController",
+    "judge_controllers",
+    "judge_protocol",
+    "run_controller",
+]
+
+
+class Judged(Interface):
+    """A controller the judge walks: picklable (it crosses to worker processes), it walks
+    ``robot`` simulated with ``options`` on ``engine`` for ``seconds`` [s] from standing
+    and measures the walk."""
+
+    def walk(
+        self, robot: Robot, options: SimOptions, seconds: float, engine: str
+    ) -> WalkMetrics: ...
 
 
 @dataclass(frozen=True)
@@ -44,20 +65,19 @@ class JudgeJob:
     """One controller on one robot of a protocol (runs in a worker process).
 
     Attributes:
-        run_dir: the run folder; robot: the robot; controller: its name (``open_loop``,
-        ``learned``); seed: the protocol's robot; options: that robot's simulation;
-        furthest: the factor it drew furthest from nominal; seconds: simulated time
-        [s]; scale: the stride scale (``None``: the run's); engine: the physics engine.
+        controller: its name in the verdict (``open_loop``, ``learned``); walker: what
+        walks (:class:`Judged`); robot: the robot; seed: the protocol's robot; options:
+        that robot's simulation; furthest: the factor it drew furthest from nominal;
+        seconds: simulated time [s]; engine: the physics engine.
     """
 
-    run_dir: str
-    robot: Robot
     controller: str
+    walker: Judged
+    robot: Robot
     seed: int
     options: SimOptions
     furthest: str | None
     seconds: float
-    scale: float | None
     engine: str
 
 
@@ -97,24 +117,38 @@ def _loaded(run_dir: str) -> LoadedRun:
     return _CACHE[key]
 
 
+@dataclass(frozen=True)
+class RunController:
+    """Controller ``name`` of the run folder ``run_dir`` (:class:`Judged`), at the stride
+    ``scale`` (``None``: the scale the run reached)."""
+
+    run_dir: str
+    name: str
+    scale: float | None = None
+
+    def walk(self, robot: Robot, options: SimOptions, seconds: float, engine: str) -> WalkMetrics:
+        """Walk it on ``robot``; its progress is judged against its reference or style."""
+        from imitwalk.sim.mujoco import make_plant, run
+
+        lr = _loaded(self.run_dir)
+        scale = lr.scale if self.scale is None else self.scale
+        ref = lr.ref
+        policy = lr.policy(self.name, robot, scale, seconds)
+        plant = make_plant(robot, ref.sim_options(options), engine)
+        ro = run(plant, policy, round(seconds / ref.dt))
+        # progress over the whole judged walk, so that an early fall scores the share of it
+        # made (about 0), not its fall over the few millimetres commanded before it
+        return walk_metrics(
+            ro,
+            ref.expected_distance(scale, seconds),
+            ref.trajectory(scale, seconds),
+            ref.track(scale, seconds),
+        )
+
+
 def run_controller(job: JudgeJob) -> RobotWalk:
     """Walk ``job``'s controller on its robot; its walk metrics, seed and furthest factor."""
-    from imitwalk.sim.mujoco import make_plant, run
-
-    lr = _loaded(job.run_dir)
-    scale = lr.scale if job.scale is None else job.scale
-    ref = lr.ref
-    policy = lr.policy(job.controller, job.robot, scale, job.seconds)
-    plant = make_plant(job.robot, ref.sim_options(job.options), job.engine)
-    ro = run(plant, policy, round(job.seconds / ref.dt))
-    # progress over the whole judged walk, so that an early fall scores the share of it
-    # made (about 0), not its fall over the few millimetres commanded before it
-    m = walk_metrics(
-        ro,
-        ref.expected_distance(scale, job.seconds),
-        ref.trajectory(scale, job.seconds),
-        ref.track(scale, job.seconds),
-    )
+    m = job.walker.walk(job.robot, job.options, job.seconds, job.engine)
     return RobotWalk(job.seed, job.furthest, m)
 
 
@@ -167,32 +201,58 @@ def judge_protocol(
     first: int = 0,
     most_falls: int | None = None,
 ) -> ProtocolVerdict:
-    """Every controller in ``controllers`` (``None``: every one the run can build) on
-    robots ``first … first + seeds − 1`` of ``protocol``: a :class:`ControllerVerdict` per
-    controller, and each one's falls compared with open loop's on the same robots
-    (McNemar). ``explain``: also walk each fall again once per factor, that factor at
-    nominal (:func:`~imitwalk.judge.explain.explain_falls`). ``first`` > 0 judges robots
-    that evaluation does not, e.g. training robots (1001 on) or validation robots (300 000
+    """Every controller in ``controllers`` that the run at ``run_dir`` builds (``None``:
+    every one it can) judged by :func:`judge_controllers`, at the stride ``scale``
+    (``None``: the one the run reached); a controller that is an exact copy of another
+    (:meth:`~imitwalk.judge.replay.LoadedRun.twin`) is walked once."""
+    loaded = _loaded(str(run_dir))
+    names = _checked_controllers(loaded, controllers)
+    twins = {c: loaded.twin(c) for c in names}
+    walkers = {t: RunController(str(run_dir), t, scale) for t in dict.fromkeys(twins.values())}
+    at = scale if scale is not None else loaded.metrics.scale_reached
+    return judge_controllers(
+        walkers, robot, protocol, seeds, seconds, at, workers, explain, first, most_falls, twins
+    )
+
+
+def judge_controllers(
+    controllers: Mapping[str, Judged],
+    robot: Robot,
+    protocol: Protocol,
+    seeds: int = 40,
+    seconds: float = 30.0,
+    scale: float | None = None,
+    workers: int | None = None,
+    explain: bool = False,
+    first: int = 0,
+    most_falls: int | None = None,
+    twins: Mapping[str, str] | None = None,
+) -> ProtocolVerdict:
+    """Every controller (name → :class:`Judged`) on robots ``first … first + seeds − 1``
+    of ``protocol``: a :class:`ControllerVerdict` per controller, and each one's falls
+    compared with open loop's (or, without it, ``default``'s) on the same robots
+    (McNemar). ``scale`` is reported as the stride the controllers walk at. ``explain``:
+    also walk each fall again once per factor, that factor at nominal
+    (:func:`~imitwalk.judge.explain.explain_falls`). ``first`` > 0 judges robots that
+    evaluation does not, e.g. training robots (1001 on) or validation robots (300 000
     on). ``most_falls`` (one controller only): stop once more robots than that fell; the
-    verdict is then on the robots walked, in seed order (fewer than ``seeds``)."""
+    verdict is then on the robots walked, in seed order (fewer than ``seeds``).
+    ``twins``: name → the name of the controller walked in its place (an exact copy; by
+    default each walks itself)."""
     if first < 0:
         raise ConfigError(f"first robot {first}: valid robots are 0 and up")
-    loaded = _loaded(str(run_dir))
-    controllers = _checked_controllers(loaded, controllers)
+    twin = dict(twins) if twins is not None else {c: c for c in controllers}
+    names = tuple(twin)
     draws = [protocol.draw(first + s, robot, seconds=seconds) for s in range(seeds)]
-    twin = {c: loaded.twin(c) for c in controllers}
-    jobs = _jobs(str(run_dir), robot, protocol, draws, twin, seconds, scale)
-    stop = _stop(controllers, most_falls)
+    jobs = _jobs(controllers, robot, protocol, draws, twin, seconds)
+    stop = _stop(names, most_falls)
     res = run_parallel(run_controller, jobs, workers, stop=stop)
     jobs = jobs[: len(res)]  # the robots walked
-    by = {
-        c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]]
-        for c in controllers
-    }
-    saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(controllers)
+    by = {c: [r for r, j in zip(res, jobs, strict=True) if j.controller == twin[c]] for c in names}
+    saved: dict[str, dict[int, tuple[str, ...]] | None] = dict.fromkeys(names)
     if explain:
         why = explain_falls(run_controller, jobs, res, protocol, robot, seconds, workers)
-        for c in controllers:
+        for c in names:
             saved[c] = {s: v for (cc, s), v in why.items() if cc == twin[c]}
     return ProtocolVerdict(
         protocol=ProtocolId(protocol.name, protocol.version, protocol.path),
@@ -201,11 +261,11 @@ def judge_protocol(
             first=first,
             seconds=seconds,
             engine=protocol.engine,
-            scale=scale if scale is not None else loaded.metrics.scale_reached,
-            controllers=tuple(controllers),
+            scale=scale,
+            controllers=names,
         ),
         controllers={c: _side(runs, protocol.factors, saved[c]) for c, runs in by.items()},
-        comparison=_comparison(by, controllers),
+        comparison=_comparison(by, names),
     )
 
 
@@ -220,28 +280,17 @@ def _checked_controllers(loaded: LoadedRun, controllers: tuple[str, ...] | None)
 
 
 def _jobs(
-    run_dir: str,
+    controllers: Mapping[str, Judged],
     robot: Robot,
     protocol: Protocol,
     draws: list[RobotDraw],
     twin: dict[str, str],
     seconds: float,
-    scale: float | None,
 ) -> list[JudgeJob]:
     """One job per distinct controller (``twin``: each one's exact copy walked in its
-    place) and drawn robot, in that order, each walking ``seconds`` [s] at ``scale``."""
+    place) and drawn robot, in that order, each walking ``seconds`` [s]."""
     return [
-        JudgeJob(
-            run_dir,
-            robot,
-            c,
-            d.seed,
-            d.options,
-            d.furthest,
-            seconds,
-            scale,
-            protocol.engine,
-        )
+        JudgeJob(c, controllers[c], robot, d.seed, d.options, d.furthest, seconds, protocol.engine)
         for c in dict.fromkeys(twin.values())  # exact copies walk once
         for d in draws
     ]

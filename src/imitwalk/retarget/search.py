@@ -39,7 +39,16 @@ from imitwalk.sim.types import ENGINES
 if TYPE_CHECKING:
     from imitwalk.retarget.reference import Reference
 
-__all__ = ["BOUNDS", "LENGTHS", "SearchConfig", "Walker", "bounds", "open_loop", "search_params"]
+__all__ = [
+    "BOUNDS",
+    "LENGTHS",
+    "SearchConfig",
+    "Walker",
+    "bounds",
+    "open_loop",
+    "search_line",
+    "search_params",
+]
 
 #: ``walker(reference, robot, scale, seed, options, seconds)`` walks a candidate
 #: :class:`~imitwalk.retarget.reference.Reference` at ``scale`` on one robot for
@@ -172,6 +181,14 @@ def _trial(
                 }
             )
     return {"params": params.to_dict(), "score": float(np.mean(score)), "runs": runs}
+
+
+def search_line(gen: int, total: int, score: float, params: dict) -> str:
+    """The search's progress after generation ``gen`` of ``total``: the best score and
+    its parameters, on one line (the ``progress`` callback of :func:`search_params`
+    formats it)."""
+    shown = ", ".join(f"{k}={v:.3g}" for k, v in params.items())
+    return f"  search generation {gen}/{total}: best score {score:.3f} ({shown})"
 
 
 def search_params(
