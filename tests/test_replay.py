@@ -42,7 +42,7 @@ def test_the_learned_controllers_add_the_kept_feedforward(tick_run, robot):
     from imitwalk.retarget.feedforward import walk_offsets
 
     lr = load_run(tick_run)
-    assert lr.settings == lr.metrics.reference_settings
+    assert lr.settings == lr.metrics.tick().reference_settings
     lr = replace(lr, settings={"feedforward": 0.5, "wait": 0.0})
     off = walk_offsets(lr.ref, robot, lr.scale, 4.0, 1.0)[: len(lr.ref.trajectory(lr.scale, 4.0))]
     for name in ("learned", "feedback", "fixed"):

@@ -13,6 +13,7 @@ import pytest
 
 from imitwalk.balance import ticktrials
 from imitwalk.balance.tickconfig import TickLearnConfig, TrialConfig
+from imitwalk.balance.ticklog import entry_from_dict
 from imitwalk.balance.tickrun import TickResult, Trial, best, blind
 from imitwalk.balance.ticktrials import Learner, TickProgress
 
@@ -167,7 +168,7 @@ def test_trials_interrupted_across_a_lowered_scale_resume_exactly(tmp_path, line
         saved = rd.read_json("checkpoint.json") if rd.exists("checkpoint.json") else {}
         if line >= 5:  # cut after the settings' checkpoint: the run resumes at 0.3
             assert saved["trial_scale"] == 0.3 and saved["settings"]
-        state, again = TickProgress(**saved), rd.read_log()
+        state, again = TickProgress(**saved), [entry_from_dict(e) for e in rd.read_log()]
         lr.say = lambda _line: None
         ticktrials.trials(lr, state, again)
     wall = {"wall_seconds": 0.0}  # the only thing that differs

@@ -24,7 +24,15 @@ from imitwalk import readback
 from imitwalk.errors import RunError
 from imitwalk.fileio import atomic_write, check_writable, writable_folder, write_npz
 
-__all__ = ["RUN_FORMAT", "LearnSummary", "RunDir"]
+__all__ = [
+    "OUTCOMES",
+    "RUN_FORMAT",
+    "FaithfulOutcome",
+    "LearnSummary",
+    "RunDir",
+    "StepOutcome",
+    "TickOutcome",
+]
 
 #: The format of a run folder's ``config.json`` and ``metrics.json`` that this imitwalk
 #: writes, and the newest it reads (:func:`~imitwalk.readback.check_format`; a file
@@ -44,12 +52,6 @@ def _json_default(v: object) -> object:
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
 
 
-_TICK_ONLY = ("trial_scale", "trial_falls", "feedback_gains", "trust", "reference_settings")
-_FAITHFUL_ONLY = ("variant", "gait")
-_STEP_ONLY = ("gains", "final")
-_ONLY = {"tick": _TICK_ONLY, "faithful": _FAITHFUL_ONLY, "step": _STEP_ONLY, "rl": ()}
-
-
 #: The types of the fields every learner writes to ``metrics.json``.
 _SUMMARY_TYPES = {
     "learner": str,
@@ -59,6 +61,53 @@ _SUMMARY_TYPES = {
     "sim_seconds_used_for_learning": float,
     "wall_seconds_for_learning": float,
     "config": dict,
+}
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """What the stepping gait's learner kept: ``gains``, by name
+    (:class:`~imitwalk.step.gains.StepGains`), and ``final``, each finalist's cost and
+    falls on the final choice's robots."""
+
+    gains: dict[str, float]
+    final: dict[str, dict[str, float]]
+
+
+@dataclass(frozen=True)
+class TickOutcome:
+    """What the per-tick learner kept.
+
+    Attributes:
+        trial_scale: the scale the trials walked at (the top one unless no candidate
+            walked a robot there); trial_falls: the kept law's falls there.
+        feedback_gains: the gains the trials kept, by channel.
+        trust: the fraction of the model-based law kept (0: none).
+        reference_settings: how the trials chose to play the reference, by name:
+            ``feedforward``, the fraction of the servo feedforward added
+            (:mod:`imitwalk.retarget.feedforward`), and ``wait``, the load share at which
+            its clock waits before a lift-off (0 or absent: none).
+    """
+
+    trial_scale: float | None = None
+    trial_falls: int | None = None
+    feedback_gains: dict[str, float] | None = None
+    trust: float | None = None
+    reference_settings: dict[str, float] | None = None
+
+
+@dataclass(frozen=True)
+class FaithfulOutcome:
+    """What the paper's learner kept: its gait model's report (``gait``)."""
+
+    gait: dict[str, Any]
+
+
+#: What a learner kept, by the learner's name (PPO's, ``rl``, keeps its policy files).
+OUTCOMES: dict[str, type[StepOutcome] | type[TickOutcome] | type[FaithfulOutcome]] = {
+    "step": StepOutcome,
+    "tick": TickOutcome,
+    "faithful": FaithfulOutcome,
 }
 
 
@@ -75,17 +124,8 @@ class LearnSummary:
         sim_seconds_used_for_learning: simulated time of every learning walk [s];
         wall_seconds_for_learning: wall time [s].
         config: the learner's settings.
-        trial_scale: ``tick``: the scale the trials walked at (the top one unless no
-            candidate walked a robot there); trial_falls: the kept law's falls there.
-        feedback_gains: ``tick``: the gains the trials kept, by channel.
-        trust: ``tick``: the fraction of the model-based law kept (0: none).
-        reference_settings: ``tick``: how the trials chose to play the reference, by
-            name: ``feedforward``, the fraction of the servo feedforward added
-            (:mod:`imitwalk.retarget.feedforward`), and ``wait``, the load share at which
-            its clock waits before a lift-off (0 or absent: none).
-        variant: ``faithful``: its variant; gait: ``faithful``: its gait model's report.
-        gains: ``step``: the kept gains, by name (:class:`~imitwalk.step.gains.StepGains`);
-        final: ``step``: each finalist's cost and falls on the final choice's robots.
+        outcome: what the learner kept, of its own kind (:data:`OUTCOMES`; ``None`` for
+            ``rl``); :meth:`step` and :meth:`tick` give it typed.
     """
 
     learner: str
@@ -95,32 +135,43 @@ class LearnSummary:
     sim_seconds_used_for_learning: float
     wall_seconds_for_learning: float
     config: dict
-    trial_scale: float | None = None
-    trial_falls: int | None = None
-    feedback_gains: dict | None = None
-    trust: float | None = None
-    reference_settings: dict | None = None
-    variant: str | None = None
-    gait: dict | None = None
-    gains: dict | None = None
-    final: dict | None = None
+    outcome: StepOutcome | TickOutcome | FaithfulOutcome | None = None
+
+    def step(self) -> StepOutcome:
+        """The stepping gait's outcome (:class:`RunError` for another learner's run)."""
+        if not isinstance(self.outcome, StepOutcome):
+            raise RunError(f"a {self.learner} run, not a stepping gait's")
+        return self.outcome
+
+    def tick(self) -> TickOutcome:
+        """The per-tick learner's outcome (:class:`RunError` for another learner's run)."""
+        if not isinstance(self.outcome, TickOutcome):
+            raise RunError(f"a {self.learner} run, not the per-tick learner's")
+        return self.outcome
 
     def to_dict(self) -> dict:
-        """Plain-JSON dictionary, without the other learner's fields."""
-        other = {k for name, keys in _ONLY.items() if name != self.learner for k in keys}
-        return {k: v for k, v in asdict(self).items() if k not in other}
+        """Plain-JSON dictionary: the common fields, then the outcome's."""
+        out = {k: v for k, v in asdict(self).items() if k != "outcome"}
+        return out | (asdict(self.outcome) if self.outcome is not None else {})
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "metrics.json") -> LearnSummary:
         """The record :meth:`to_dict` wrote; :class:`RunError` naming the missing keys
         if ``d`` (read from ``where``) lacks any."""
-        optional = {k for keys in _ONLY.values() for k in keys}
-        required = [f.name for f in fields(cls) if f.name not in optional]
+        required = [f.name for f in fields(cls) if f.name != "outcome"]
         missing = [k for k in required if not isinstance(d, dict) or k not in d]
         if missing:
             raise RunError(f"{where} lacks {', '.join(missing)}: not a finished imitwalk run")
         readback.check_fields(d, _SUMMARY_TYPES, where, RunError)
-        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
+        kind = OUTCOMES.get(d["learner"])
+        outcome = None
+        if kind is not None:
+            try:
+                outcome = kind(**{f.name: d[f.name] for f in fields(kind) if f.name in d})
+            except TypeError:  # a required field missing
+                need = ", ".join(f.name for f in fields(kind))
+                raise RunError(f"{where}: a {d['learner']} run's summary needs {need}") from None
+        return cls(**{k: d[k] for k in required}, outcome=outcome)
 
 
 class RunDir:

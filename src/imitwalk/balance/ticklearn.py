@@ -65,7 +65,7 @@ from imitwalk.balance.ticktrials import (
 from imitwalk.config import to_dict
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
-from imitwalk.runs import LearnSummary, RunDir
+from imitwalk.runs import LearnSummary, RunDir, TickOutcome
 from imitwalk.sim.seeds import TRAIN_SEED_BASE
 
 __all__ = ["TickProgress", "learn_tick"]
@@ -213,11 +213,13 @@ def learn_tick(
         sim_seconds_used_for_learning=state.sim_seconds,
         wall_seconds_for_learning=state.wall_seconds,
         config=to_dict(config),
-        trial_scale=trial_scale,
-        trial_falls=trial_falls,
-        feedback_gains=state.gains,
-        trust=state.trust,
-        reference_settings=state.settings,
+        outcome=TickOutcome(
+            trial_scale=trial_scale,
+            trial_falls=trial_falls,
+            feedback_gains=state.gains,
+            trust=state.trust,
+            reference_settings=state.settings,
+        ),
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary

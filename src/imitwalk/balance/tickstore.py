@@ -116,17 +116,17 @@ def load_laws(run_dir: str | Path) -> dict[str, tuple[FeedbackLaw, ...]]:
     trial-picked law), ``learned`` (with the kept fraction of the model-based law on top)
     and ``fixed`` (the named hand-set baseline: 0.05 × gyro_y on both ankle pitches)."""
     rd = RunDir(run_dir)
-    metrics = rd.read_summary()
+    kept = rd.read_summary().tick()
     cfg = from_dict(TickLearnConfig, rd.read_json("config.json", ("learn",))["learn"])
-    if metrics.feedback_gains is None:
+    if kept.feedback_gains is None:
         raise RunError(f"{rd.file('metrics.json')} has no feedback_gains: not a per-tick run")
     profiles = rd.read_json("checkpoint.json").get("profiles", {})  # none before 2026-12-04
-    base = feedback_law(cfg, metrics.feedback_gains, profiles)
+    base = feedback_law(cfg, kept.feedback_gains, profiles)
     fixed = FeedbackLaw.zero(("ankle_pitch",), ("gyro_y",), cfg.trials.box).with_gain(
         "ankle_pitch", "gyro_y", 0.05
     )
     learned: tuple[FeedbackLaw, ...] = (base,)
-    frac = float(metrics.trust or 0.0)
+    frac = float(kept.trust or 0.0)
     law = load_learned(rd)
     if frac > 0 and law is not None:
         learned = (base, replace(law, gains=law.gains * frac))

@@ -21,7 +21,7 @@ from imitwalk.evidence import curves, plots
 from imitwalk.fileio import atomic_write
 from imitwalk.judge.replay import LoadedRun
 from imitwalk.robots import Robot
-from imitwalk.runs import LearnSummary
+from imitwalk.runs import LearnSummary, TickOutcome
 from imitwalk.sim.mujoco import MujocoPlant, Rollout, SimOptions, make_plant, run
 
 if TYPE_CHECKING:
@@ -87,17 +87,18 @@ def outcome(ro: Rollout) -> str:
 def summary_phrase(metrics: LearnSummary) -> str:
     """What a run kept, in a phrase: a per-tick run's trial-picked reference settings,
     gains and the fraction of its model-based law; a faithful run's iterations."""
-    gains = metrics.feedback_gains
-    if gains is None:
+    kept = metrics.outcome
+    if not isinstance(kept, TickOutcome) or kept.feedback_gains is None:
         return f"{metrics.iterations} iterations of the paper's learner"
+    gains = kept.feedback_gains
     names = {g.name: f"{g.feature} → {g.channel.replace('_', ' ')}" for g in TRIAL_GAINS}
-    kept = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
-    trust = metrics.trust
+    chosen = ", ".join(f"{names.get(k, k)} {v:g}" for k, v in gains.items())
+    trust = kept.trust
     learned = "" if trust is None else f"; model-based law kept at {trust:g}"
-    played = metrics.reference_settings or {}
+    played = kept.reference_settings or {}
     ref = ", ".join(f"{k} {v:g}" for k, v in played.items())
     ref = f"reference played with {ref}; " if ref else ""
-    return f"{ref}trial-picked gains {kept}{learned}"
+    return f"{ref}trial-picked gains {chosen}{learned}"
 
 
 def _label(frame: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]]) -> np.ndarray:

@@ -142,7 +142,7 @@ def _learning(rd: RunDir, lg: LoadedRun) -> str:
     ax.set_xlabel("CMA-ES generation")
     ax.set_ylabel("cost (1 and above: a fall)")
     ax.legend(fontsize=8)
-    kept = ", ".join(f"{k} {v:.3g}" for k, v in (m.gains or {}).items())
+    kept = ", ".join(f"{k} {v:.3g}" for k, v in m.step().gains.items())
     caption = (
         f"{m.iterations} CMA-ES generations on training robots; "
         f"{m.sim_seconds_used_for_learning:.0f} s simulated, "

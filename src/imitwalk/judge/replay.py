@@ -258,7 +258,7 @@ def load_run(run_dir: str | Path) -> LoadedRun:
 
         ref = Reference.load(rd.file("reference.npz"))
         scale = float(metrics.scale_reached)
-        laws, settings = load_laws(rd.path), metrics.reference_settings
+        laws, settings = load_laws(rd.path), metrics.tick().reference_settings
         return LoadedRun(str(rd.path), "tick", ref, scale, engine, metrics, laws, settings=settings)
     from imitwalk.paper.evaluate import load_gait
 

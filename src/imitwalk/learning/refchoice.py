@@ -114,7 +114,7 @@ class LawWalker:
 def law_walker(run_dir: str | Path) -> LawWalker:
     """The :class:`LawWalker` of the finished per-tick run in ``run_dir``."""
     rd = RunDir(run_dir)
-    settings = rd.read_summary().reference_settings or {}
+    settings = rd.read_summary().tick().reference_settings or {}
     learn = rd.read_json("config.json", ("learn",))["learn"]
     return LawWalker(
         load_laws(run_dir)["feedback"][0],

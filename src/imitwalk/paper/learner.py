@@ -27,7 +27,7 @@ from imitwalk.paper.predictor import SensoryMotorModel
 from imitwalk.parallel import run_parallel
 from imitwalk.retarget.reference import Reference
 from imitwalk.robots import Robot
-from imitwalk.runs import LearnSummary, RunDir
+from imitwalk.runs import FaithfulOutcome, LearnSummary, RunDir
 from imitwalk.sim.perturb import train_seeds
 
 __all__ = ["FaithfulProgress", "learn"]
@@ -127,8 +127,7 @@ def learn(
         sim_seconds_used_for_learning=state.sim_seconds,
         wall_seconds_for_learning=state.wall_seconds,
         config=asdict(config),
-        variant="faithful",
-        gait=gait.report(),
+        outcome=FaithfulOutcome(gait=gait.report()),
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary

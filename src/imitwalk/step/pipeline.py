@@ -27,7 +27,7 @@ import numpy as np
 from imitwalk.errors import MocapError, RunError
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.robots import Robot
-from imitwalk.runs import LearnSummary, RunDir
+from imitwalk.runs import LearnSummary, RunDir, StepOutcome
 from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
@@ -116,8 +116,7 @@ def learn_clip(
         sim_seconds_used_for_learning=res.sim_seconds,
         wall_seconds_for_learning=max(res.wall_seconds, time.perf_counter() - t0),
         config=cfg.to_dict(),
-        gains=res.gains.to_dict(),
-        final=res.final,
+        outcome=StepOutcome(gains=res.gains.to_dict(), final=res.final),
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary
