@@ -9,7 +9,6 @@ import mujoco
 import numpy as np
 import pybullet as pb
 import pytest
-from tests.test_other_robot import _other_robot
 
 from imitwalk.balance.tickconfig import TickLearnConfig
 from imitwalk.cli.main import main
@@ -22,6 +21,7 @@ from imitwalk.sim.bullet import BulletPlant
 from imitwalk.sim.mujoco import MujocoPlant, make_plant, playback, run
 from imitwalk.sim.perturb import perturbed
 from imitwalk.sim.types import jitter_draws
+from tests.test_other_robot import _other_robot
 
 
 def test_urdf_carries_masses_and_frames(robot):

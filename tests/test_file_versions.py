@@ -10,12 +10,12 @@ import shutil
 
 import numpy as np
 import pytest
-from tests.test_cli_hostile_files import _rewritten, refused
 
 from imitwalk.readback import check_format
 from imitwalk.retarget import Reference
 from imitwalk.retarget.reffile import REFERENCE_FORMAT
 from imitwalk.runs import RUN_FORMAT, RunDir
+from tests.test_cli_hostile_files import _rewritten, refused
 
 
 def _meta(path) -> dict:

@@ -8,11 +8,11 @@ import json
 from pathlib import Path
 
 import pytest
-from tests.test_cli_hostile_files import refused
 
 from imitwalk.cli.main import main
 from imitwalk.robots import BUILTIN, load_robot
 from imitwalk.sim.standing import CHECK_SECONDS, TILT_LIMIT_DEG, stand_test
+from tests.test_cli_hostile_files import refused
 
 
 def _hoap2_with_legs(tmp_path: Path, kp: float, name: str = "weak.json") -> Path:
