@@ -146,7 +146,7 @@ def _trust(
     where the trial-picked law alone did not fall, a larger fraction could at best tie,
     and lose on its size, so it is not walked. Measured: this saves 280 simulated seconds
     on every run whose trial-picked law did not fall, and every run keeps its law
-    (BENCHMARKS.md, "Learning cost")."""
+    (docs/history/benchmarks-0.2.md, "Learning cost")."""
     cfg = lr.cfg
     if learned is None:
         state.trust, state.stage = 0.0, "done"
