@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from imitwalk.errors import ConfigError
 from imitwalk.step.gains import BOUNDS, StepGains
-from imitwalk.step.kinematics import BodyModel, FootPose, rot_z
+from imitwalk.step.kinematics import BodyModel, FootPose, floor_mat, rot_z
 from imitwalk.step.style import GaitStyle, hip_height, style_from_template
 
 
@@ -70,6 +72,32 @@ def test_the_leg_ik_reaches_its_targets(robot):
     assert np.all(q >= robot.limits[:, 0] - 1e-9) and np.all(q <= robot.limits[:, 1] + 1e-9)
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-0.2, 0.2, allow_nan=False), st.floats(-0.2, 0.2, allow_nan=False))
+def test_the_floors_tilt_lays_a_level_sole_onto_the_floor(sx, sy):
+    """A level sole's normal turned by :func:`floor_mat` is the floor's normal, and a
+    line along the sole's x stays in the vertical plane x-z (the yaw is left alone)."""
+    m = floor_mat(np.array([sx, sy]))
+    normal = np.array([-sx, -sy, 1.0]) / np.sqrt(1 + sx * sx + sy * sy)
+    assert np.allclose(m @ np.array([0.0, 0.0, 1.0]), normal, atol=1e-12)
+    assert np.allclose(m @ m.T, np.eye(3), atol=1e-12) and np.linalg.det(m) > 0
+    assert abs((m @ np.array([1.0, 0.0, 0.0]))[1]) < 1e-12
+
+
+def test_the_leg_ik_lays_both_soles_onto_a_tilted_floor(robot):
+    body = BodyModel(robot)
+    body.set(robot.stand)
+    feet = {s: FootPose(body.sole_pos(s), 0.0) for s in "lr"}
+    tilt = floor_mat(np.array([0.0, np.tan(np.radians(4.0))]))
+    q = robot.stand.copy()
+    for _ in range(4):
+        q = body.solve_legs(q, feet, rot_z(0.0), iterations=3, floor=tilt)
+    body.set(q)
+    for s in "lr":
+        normal = body.sole_mat(s) @ body._flat[s].T[:, 2]
+        assert np.degrees(np.arccos(normal @ tilt[:, 2])) < 0.05
+
+
 def test_static_torques_hold_the_standing_robot(robot):
     """Torques from the model, with the weight shared by the soles under the centre of
     mass, equal what holds the standing robot in MuJoCo (its servos at rest)."""
@@ -112,3 +140,25 @@ def test_the_estimator_sees_a_robot_standing_still(robot):
     assert np.linalg.norm(e.com_vel) < 0.01
     assert np.allclose(e.dcm, e.com[:2], atol=5e-3)
     assert e.cop is not None and e.cop[1] == pytest.approx(e.com[1], abs=1e-2)
+
+
+def test_the_estimator_reads_a_floor_sloped_across_from_the_stance_sole(robot):
+    """Standing on a floor rising 4° to the left, the settled slope across converges on
+    the floor's (its tilt from the IMU and the encoders only), and none along."""
+    from dataclasses import replace
+
+    from imitwalk.sim.mujoco import MujocoPlant
+    from imitwalk.sim.types import SimOptions
+    from imitwalk.step.estimator import SETTLED_TAU, BodyEstimator
+    from imitwalk.step.lipm import omega_of
+
+    body = BodyModel(robot)
+    est = BodyEstimator(body, 0.01, omega_of(0.23))
+    plant = MujocoPlant(robot, replace(SimOptions(), cross_slope_deg=4.0))
+    obs = plant.reset()
+    for _ in range(int(4 * SETTLED_TAU / 0.01)):
+        e = est.update(obs, np.zeros(2))
+        plant.command(robot.stand)
+        obs = plant.step()
+    assert e.settled_slope[1] == pytest.approx(np.tan(np.radians(4.0)), abs=0.015)
+    assert abs(e.settled_slope[0]) < 0.015

@@ -82,6 +82,7 @@ class JointSolver:
         phase: float,
         loads: dict[str, tuple[float, np.ndarray]],
         ankle_zmp: np.ndarray,
+        floor: np.ndarray | None = None,
     ) -> np.ndarray:
         """Joint targets ``(n,)`` [rad].
 
@@ -91,14 +92,15 @@ class JointSolver:
             sole's commanded pose; phase: the gait phase ψ for the arms and waist; loads:
             per side, its share of the weight and the point ``(3,)`` where it presses
             [m] (stance frame); ankle_zmp: ``(2,)`` the ZMP shift asked of the ankles
-            [m].
+            [m]; floor: ``(3, 3)`` the floor's tilt both soles are laid onto
+            (:func:`~imitwalk.step.kinematics.floor_mat`), ``None``: level.
         """
         r = self.robot
         pelvis = np.array([*(com - self.com_off), height])
         turn = rot_z(0.5 * other.yaw)
         swing = "l" if stance == "r" else "r"
         feet = {stance: FootPose(-pelvis, 0.0), swing: FootPose(other.pos - pelvis, other.yaw)}
-        q = self.ik.solve_legs(self.q, feet, turn, iterations=2)
+        q = self.ik.solve_legs(self.q, feet, turn, iterations=2, floor=floor)
         offsets = self.style.upper_at(phase)
         for role, j in self._upper.items():
             q[j] = r.stand[j] + offsets[role]

@@ -13,6 +13,7 @@ warm-started from the last tick's answer, so a few iterations per tick suffice.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -43,6 +44,17 @@ def rot_xyz(roll: float, pitch: float, yaw: float) -> np.ndarray:
     ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
     rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
     return rot_z(yaw) @ ry @ rx
+
+
+def floor_mat(slope: np.ndarray) -> np.ndarray:
+    """``(3, 3)`` the rotation that lays a level sole onto a floor rising ``slope``
+    ``(2,)`` [m per m] along x and y: it turns z onto the floor's normal ``(-sx, -sy,
+    1)`` and x onto the floor's line along x, ``(1, 0, sx)`` (both normalised)."""
+    sx, sy = float(slope[0]), float(slope[1])
+    hx, n = math.sqrt(1.0 + sx * sx), math.sqrt(1.0 + sx * sx + sy * sy)
+    x0, x2 = 1.0 / hx, sx / hx  # x: the floor's line along x
+    z0, z1, z2 = -sx / n, -sy / n, 1.0 / n  # z: its normal; y = z × x
+    return np.array([[x0, z1 * x2, z0], [0.0, z2 * x0 - z0 * x2, z1], [x2, -z1 * x0, z2]])
 
 
 def _quat(mat: np.ndarray) -> np.ndarray:
@@ -188,6 +200,7 @@ class BodyModel:
         pelvis_mat: np.ndarray,
         iterations: int = 3,
         damping: float = 1e-6,
+        floor: np.ndarray | None = None,
     ) -> np.ndarray:
         """Leg joints that put each sole at its pose, the pelvis at the origin turned by
         ``pelvis_mat`` (foot poses in the same frame as the pelvis's).
@@ -197,13 +210,16 @@ class BodyModel:
             feet: per side, the sole's target :class:`FootPose`.
             pelvis_mat: ``(3, 3)`` the pelvis's orientation.
             iterations: Newton steps; damping: their Levenberg–Marquardt damping.
+            floor: ``(3, 3)`` the floor's tilt (:func:`floor_mat`) both soles are laid
+                onto; ``None``: level.
 
         Returns:
             ``(n,)`` the posture, clipped to the joint ranges.
         """
         m, d = self.m, self.d
         q = q.copy()
-        targets = {s: (f.pos, rot_z(f.yaw) @ self._flat[s]) for s, f in feet.items()}
+        tilt = np.eye(3) if floor is None else floor
+        targets = {s: (f.pos, tilt @ rot_z(f.yaw) @ self._flat[s]) for s, f in feet.items()}
         for _ in range(iterations):
             self.set(q, pelvis_mat)
             for s, (pos, mat) in targets.items():
