@@ -218,8 +218,8 @@ class BodyModel:
         """
         m, d = self.m, self.d
         q = q.copy()
-        tilt = np.eye(3) if floor is None else floor
-        targets = {s: (f.pos, tilt @ rot_z(f.yaw) @ self._flat[s]) for s, f in feet.items()}
+        turn = {s: rot_z(f.yaw) if floor is None else floor @ rot_z(f.yaw) for s, f in feet.items()}
+        targets = {s: (f.pos, turn[s] @ self._flat[s]) for s, f in feet.items()}
         for _ in range(iterations):
             self.set(q, pelvis_mat)
             for s, (pos, mat) in targets.items():
