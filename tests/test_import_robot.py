@@ -254,3 +254,35 @@ def test_bullet_says_what_the_robots_rotors_are(drafted, capsys):
     assert rotor_ratio(load_robot(_import(drafted, "g1", capsys)[0])) < 1.0
     note = rotor_note(load_robot("hoap2"))
     assert "\n" not in note and "hoap2's leg rotors are 3.5 x" in note
+
+
+def test_g1_starts_the_stepping_gait_without_a_spin_or_a_false_tilt(drafted, capsys):
+    """Set down onto the floor, G1's first half second under the stepping gait: its arms
+    swing in (set at once, their kp-500 servos yawed the torso at 5 rad/s) and its tilt
+    averages the landing's jolt in (taken from the first reading, it was 34° off)."""
+    from scipy.spatial.transform import Rotation
+
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.sim.mujoco import MujocoPlant
+    from imitwalk.step.controller import SteppingController
+    from imitwalk.step.gains import StepGains
+    from imitwalk.step.pipeline import gait_from_motion
+
+    path, _ = _import(drafted, "g1", capsys)
+    robot = load_robot(path)
+    style = gait_from_motion(load_motion(default_clip()), robot).style
+    ctrl = SteppingController(robot, style, StepGains(), 0.01)
+    plant = MujocoPlant(robot)
+    obs = plant.reset()
+    spin, tilt_err = 0.0, 0.0
+    for k in range(50):
+        plant.command(ctrl(k, obs))
+        obs = plant.step()
+        spin = max(spin, abs(float(obs.gyro[2])))
+        if k >= 1:  # the controller's tilt against the torso's true one (the test's, not its)
+            quat = plant.data.xquat[plant.model.body(robot.torso).id]
+            true = Rotation.from_quat(quat[[1, 2, 3, 0]]).as_euler("xyz")
+            t = ctrl.est._last_tilt
+            tilt_err = max(tilt_err, abs(t.roll - true[0]), abs(t.pitch - true[1]))
+    assert spin < 1.0  # [rad/s]
+    assert np.degrees(tilt_err) < 8.0

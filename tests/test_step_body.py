@@ -162,3 +162,92 @@ def test_the_estimator_reads_a_floor_sloped_across_from_the_stance_sole(robot):
         obs = plant.step()
     assert e.settled_slope[1] == pytest.approx(np.tan(np.radians(4.0)), abs=0.015)
     assert abs(e.settled_slope[0]) < 0.015
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    roll=st.floats(-0.3, 0.3),
+    pitch=st.floats(-0.3, 0.3),
+    jolt=st.floats(-60.0, 60.0),
+)
+def test_the_attitude_starts_level_and_averages_its_readings_in(roll, pitch, jolt):
+    """With a prior, one jolted reading (a landing) moves the tilt by at most its share
+    dt / (prior + dt); steady readings of a tilt are then averaged in, and after a few
+    time constants the tilt is theirs (a complementary filter, the gyro at rest)."""
+    from imitwalk.balance.estimator import StateEstimator
+    from imitwalk.step.estimator import TILT_PRIOR
+
+    dt, g = 0.01, 9.81
+    est = StateEstimator(dt, 0.5, prior=TILT_PRIOR)
+    est.update(np.zeros(3), np.zeros(3), np.zeros((2, 4)))  # free fall: nothing learnt
+    assert est.roll == est.pitch == 0.0
+    est.update(np.zeros(3), np.array([jolt, 0.0, g]), np.zeros((2, 4)))
+    share = dt / (TILT_PRIOR + dt)
+    assert abs(est.pitch) <= share * abs(np.arctan2(-jolt, g)) + 1e-12
+    # gravity as an accelerometer tilted by (roll, pitch) reads it
+    a = g * np.array([-np.sin(pitch), np.sin(roll) * np.cos(pitch), np.cos(roll) * np.cos(pitch)])
+    for _ in range(300):
+        est.update(np.zeros(3), a, np.zeros((2, 4)))
+    assert est.roll == pytest.approx(roll, abs=0.01)
+    assert est.pitch == pytest.approx(pitch, abs=0.01)
+
+
+def test_the_first_joint_targets_carry_no_velocity_feedforward(robot):
+    """The jump from the measured posture to the walking one is not a velocity: the
+    first targets are the posture solved plus the static feedforward alone."""
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.step.gains import StepGains
+    from imitwalk.step.joints import JointSolver
+    from imitwalk.step.pipeline import gait_from_motion
+
+    style = gait_from_motion(load_motion(default_clip()), robot).style
+    gains = StepGains(feedforward=1.0)
+    solver = JointSolver(robot, style, gains, 0.01)
+    far = robot.stand.copy()
+    far[robot.index("l_knee")] += 0.3  # measured: a knee 17° off the walking posture
+    solver.reset(far)
+    other = FootPose(np.array([0.0, style.step_width, 0.0]), 0.0)
+    z = style.pelvis_height
+    out = solver.solve("r", np.array([0.0, style.step_width / 2]), z, other, 0.0, {}, np.zeros(2))
+    assert np.abs(solver.q - far).max() > 0.05  # the posture moved ...
+    static = solver.ik.static_torques({}) / solver.kp
+    assert np.allclose(out, solver.q + static)  # ... and no velocity was fed forward
+    # the second tick's targets do carry the velocity of their motion
+    out2 = solver.solve("r", np.array([0.01, style.step_width / 2]), z, other, 0.0, {}, np.zeros(2))
+    vel = solver.ik.kv * (solver.q - solver.q_prev) / 0.01 / solver.kp
+    assert np.allclose(out2, solver.q + vel + solver.ik.static_torques({}) / solver.kp)
+
+
+def test_the_arms_swing_in_from_standing(robot):
+    """At the first tick the arms and waist hold their standing angles: the style's
+    swing is ramped in over the start's double support, not set at once."""
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.sim.mujoco import MujocoPlant
+    from imitwalk.step.controller import SteppingController
+    from imitwalk.step.gains import StepGains
+    from imitwalk.step.pipeline import gait_from_motion
+
+    style = gait_from_motion(load_motion(default_clip()), robot).style
+    ctrl = SteppingController(robot, style, StepGains(), 0.01)
+    plant = MujocoPlant(robot)
+    obs = plant.reset()
+    upper = [robot.index(r) for r in style.upper if r in robot.joint_names]
+    assert upper
+    swing = max(abs(v).max() for v in style.upper.values())
+    assert swing > 0.05  # the style does swing its arms
+    q = ctrl(0, obs)  # the targets; the posture solved (no feedforward) is ctrl.joints.q
+    assert np.allclose(ctrl.joints.q[upper], robot.stand[upper])
+    for k in range(1, 200):
+        plant.command(q)
+        obs = plant.step()
+        q = ctrl(k, obs)
+        if ctrl.single:
+            break
+    assert ctrl.single  # lifted off: the swing is in full
+    offsets = style.upper_at(ctrl._phase())
+    solved = ctrl.joints.q
+    assert all(
+        solved[robot.index(r)] == pytest.approx(robot.stand[robot.index(r)] + offsets[r])
+        for r in style.upper
+        if r in robot.joint_names
+    )

@@ -54,33 +54,51 @@ class StateEstimator:
 
     Args:
         dt: control period [s]; tau: time constant pulling the tilt towards the
-            accelerometer [s] (long: trust the gyro; short: trust the accelerometer).
+            accelerometer [s] (long: trust the gyro; short: trust the accelerometer);
+        prior: ``None``: the tilt starts from the first reading that feels gravity (see
+            :meth:`update`); a time [s]: it starts level, and that belief counts as
+            ``prior`` seconds of level readings, so until ``tau`` has passed the tilt is
+            the running mean of the readings and that prior (the filter's time constant
+            grows from ``prior`` to ``tau``). One reading cannot then set it: a robot set
+            down onto the floor lands, and its accelerometer reads the landing's jolt
+            (Unitree G1: 34° of pitch on its first reading, which put the centre of
+            mass 0.37 m ahead of its feet).
     """
 
-    def __init__(self, dt: float, tau: float = 0.5):
-        self.dt, self.tau = dt, tau
+    def __init__(self, dt: float, tau: float = 0.5, prior: float | None = None):
+        self.dt, self.tau, self.prior = dt, tau, prior
         self.reset()
 
     def reset(self) -> None:
         """Level, heading zero."""
         self.roll = self.pitch = self.heading = 0.0
         self._started = False
+        self._elapsed = 0.0  # [s] of readings that felt gravity (``prior`` only)
 
     def update(self, gyro: np.ndarray, accel: np.ndarray, foot_force: np.ndarray) -> Estimate:
         """Fold in one tick of readings: gyro ``(3,)`` [rad/s], accel ``(3,)`` [m/s²],
         foot_force ``(2, k)`` [N].
 
-        The tilt starts from the first reading that feels gravity (|accel| above half of
-        it): a robot set down a fraction of a millimetre above the floor is in free fall
-        for its first tick, and that reading's direction says nothing (it read −180° of
-        roll, which the filter took a second to forget). Until then the tilt is level.
+        Without a ``prior``, the tilt starts from the first reading that feels gravity
+        (|accel| above half of it): a robot set down a fraction of a millimetre above the
+        floor is in free fall for its first tick, and that reading's direction says
+        nothing (it read −180° of roll, which the filter took a second to forget). Until
+        then the tilt is level. With one, it starts level (see the class doc).
         """
         gyro = np.asarray(gyro, dtype=float)
         ax, ay, az = np.asarray(accel, dtype=float)
         acc_roll = float(np.arctan2(ay, az))
         acc_pitch = float(np.arctan2(-ax, np.hypot(ay, az)))
         feels_gravity = np.hypot(np.hypot(ax, ay), az) > 0.5 * GRAVITY
-        if not self._started or not np.isfinite(acc_roll):
+        if self.prior is not None:  # level at first, the readings averaged in
+            self.roll += gyro[0] * self.dt
+            self.pitch += gyro[1] * self.dt
+            if feels_gravity and np.isfinite(acc_roll):
+                w = self.dt / (min(self.tau, self.prior + self._elapsed) + self.dt)
+                self.roll += w * (acc_roll - self.roll)
+                self.pitch += w * (acc_pitch - self.pitch)
+                self._elapsed += self.dt
+        elif not self._started or not np.isfinite(acc_roll):
             if feels_gravity and np.isfinite(acc_roll):
                 self.roll, self.pitch, self._started = acc_roll, acc_pitch, True
         else:

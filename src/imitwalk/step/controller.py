@@ -19,7 +19,9 @@ sensors. Every control tick:
    floor (or lower it further when the floor is late); lift the trailing foot once it
    has unloaded.
 5. **Solve the joints** (:mod:`imitwalk.step.joints`): both soles, the pelvis, the arms
-   and waist, and the servos' feedforward and the ankles' share of the balance. The
+   and waist (their swing ramped in over the start's double support: set to its first
+   phase at once, Unitree G1's arms yawed its torso at 5 rad/s), and the servos'
+   feedforward and the ankles' share of the balance. The
    soles are laid onto the floor's slope across the walk, as the stance sole's attitude
    gives it over :data:`~imitwalk.step.estimator.SETTLED_TAU` (a level sole on a floor
    tilted across stands on its edge: 12 of 40 ``cross`` robots fell at 3° without it).
@@ -298,9 +300,11 @@ class SteppingController:
 
     def _joints(self, e: BodyEstimate) -> np.ndarray:
         st, g = self.style, self.gains
+        upper = 1.0
         if self.steps == 0 and not self.single:  # settling: the pelvis lowers to its height
             a = _smooth(self.t_phase / (SETTLE * st.step_time))
             height = (1 - a) * self.z0 + a * self.pelvis_z
+            upper = _smooth(self.t_phase / self.ds_time)  # the arms swing in by lift-off
         else:
             height = self.pelvis_z
         other = self.swing.command() if self.single else self.trail
@@ -313,7 +317,7 @@ class SteppingController:
         com = self.c_ref + g.lead * self.v_ref
         across = floor_mat(np.array([0.0, e.settled_slope[1]]))
         return self.joints.solve(
-            self.stance, com, height, other, self._phase(), loads, self.ankle_zmp, across
+            self.stance, com, height, other, self._phase(), loads, self.ankle_zmp, across, upper
         )
 
     @property

@@ -4,7 +4,8 @@ Each tick :class:`BodyEstimator` turns an :class:`~imitwalk.sim.types.Observatio
 into a :class:`BodyEstimate` in the **stance frame**: origin at the stance sole's centre,
 x along that sole's heading, z up along gravity.
 
-* **Attitude**: roll and pitch from the gyro and accelerometer (a complementary filter),
+* **Attitude**: roll and pitch from the gyro and accelerometer (a complementary filter
+  that starts level and averages the first readings in: :data:`TILT_PRIOR`),
   heading from the integrated yaw rate (:class:`~imitwalk.balance.estimator.StateEstimator`).
 * **Kinematics**: the encoders posed on the robot's model with the pelvis turned by that
   attitude give the centre of mass, the swing sole and the sole force sensors relative
@@ -43,6 +44,10 @@ SLOPE_TAU = 0.3
 #: ... and with this one [s] for the soles' tilt across the walk (``settled_slope``),
 #: picked by trials on training robots (the module doc of :mod:`imitwalk.step.controller`).
 SETTLED_TAU = 1.5
+#: The attitude starts level, a belief worth this many seconds of level readings [s]
+#: (:class:`~imitwalk.balance.estimator.StateEstimator`'s ``prior``): the first readings
+#: are the landing's jolt when the robot is set down.
+TILT_PRIOR = 0.1
 
 
 @dataclass(frozen=True)
@@ -128,7 +133,7 @@ class BodyEstimator:
     ):
         self.body, self.dt, self.omega = body, dt, omega
         self.gain = observer_gain(omega, dt, noise or ObserverNoise())
-        self._tilt = StateEstimator(dt, tilt_tau)
+        self._tilt = StateEstimator(dt, tilt_tau, prior=TILT_PRIOR)
         ch, sh = np.cosh(omega * dt), np.sinh(omega * dt)
         self._a = np.array([[ch, sh / omega], [omega * sh, ch]])
         self._b = np.array([1.0 - ch, -omega * sh])

@@ -47,8 +47,11 @@ class JointSolver:
         self.reset(robot.stand)
 
     def reset(self, q: np.ndarray) -> None:
-        """Start from the measured posture ``q`` ``(n,)`` [rad]."""
+        """Start from the measured posture ``q`` ``(n,)`` [rad] (the first solve's jump
+        from it to the walking posture carries no velocity feedforward: over one tick
+        it read as several rad/s, a kick of the servos' damping)."""
         self.q = self.q_prev = np.asarray(q, dtype=float).copy()
+        self._first = True
         self.ik.set(self.q)
         self.com_off = self.ik.com()[:2]  # the centre of mass ahead of the pelvis
 
@@ -83,6 +86,7 @@ class JointSolver:
         loads: dict[str, tuple[float, np.ndarray]],
         ankle_zmp: np.ndarray,
         floor: np.ndarray | None = None,
+        upper: float = 1.0,
     ) -> np.ndarray:
         """Joint targets ``(n,)`` [rad].
 
@@ -93,7 +97,8 @@ class JointSolver:
             per side, its share of the weight and the point ``(3,)`` where it presses
             [m] (stance frame); ankle_zmp: ``(2,)`` the ZMP shift asked of the ankles
             [m]; floor: ``(3, 3)`` the floor's tilt both soles are laid onto
-            (:func:`~imitwalk.step.kinematics.floor_mat`), ``None``: level.
+            (:func:`~imitwalk.step.kinematics.floor_mat`), ``None``: level; upper: the
+            share [0, 1] of the style's arm and waist swing (ramped in at the start).
         """
         r = self.robot
         pelvis = np.array([*(com - self.com_off), height])
@@ -103,10 +108,11 @@ class JointSolver:
         q = self.ik.solve_legs(self.q, feet, turn, iterations=2, floor=floor)
         offsets = self.style.upper_at(phase)
         for role, j in self._upper.items():
-            q[j] = r.stand[j] + offsets[role]
+            q[j] = r.stand[j] + upper * offsets[role]
         self.ik.set(q, turn)
         self.com_off = self.ik.com()[:2]
-        self.q_prev, self.q = self.q, q
+        self.q_prev, self.q = (q if self._first else self.q), q
+        self._first = False
         out = q.copy()
         g = self.gains
         if g.feedforward:  # the servos' static sag, and their damping's lag: τ = kp e − kv q̇
