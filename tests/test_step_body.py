@@ -244,7 +244,7 @@ def test_the_arms_swing_in_from_standing(robot):
         if ctrl.single:
             break
     assert ctrl.single  # lifted off: the swing is in full
-    offsets = style.upper_at(ctrl._phase())
+    offsets = style.upper_at(ctrl.phase)
     solved = ctrl.joints.q
     assert all(
         solved[robot.index(r)] == pytest.approx(robot.stand[robot.index(r)] + offsets[r])
