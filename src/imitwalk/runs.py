@@ -67,11 +67,13 @@ _SUMMARY_TYPES = {
 @dataclass(frozen=True)
 class StepOutcome:
     """What the stepping gait's learner kept: ``gains``, by name
-    (:class:`~imitwalk.step.gains.StepGains`), and ``final``, each finalist's cost and
-    falls on the final choice's robots."""
+    (:class:`~imitwalk.step.gains.StepGains`); ``final``, each finalist's cost and
+    falls on the final choice's robots; ``pace``, how the stride was chosen
+    (:class:`~imitwalk.step.pace.PaceChoice`'s dictionary; ``None`` in older runs)."""
 
     gains: dict[str, float]
     final: dict[str, dict[str, float]]
+    pace: dict[str, Any] | None = None
 
 
 @dataclass(frozen=True)

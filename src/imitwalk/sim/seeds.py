@@ -14,7 +14,8 @@ range                   name                        used by
                                                     the per-tick learner's models, the
                                                     reference search, the RL environment,
                                                     the reference choice
-100 001 … 199 999       :data:`TRIAL_FIRST` on      the per-tick learner's gain trials
+100 001 … 199 999       :data:`TRIAL_FIRST` on      the per-tick learner's gain trials,
+                                                    the stepping gait's stride trials
 200 001 … 299 999       :data:`FINAL_FIRST` on      the stepping gait's final choice
 300 000 …               :data:`VALIDATION_FIRST` on validation robots, walked once to
                                                     check a choice, never to make one

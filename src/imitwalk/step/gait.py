@@ -25,8 +25,9 @@ from imitwalk.step.schedule import START_STEPS, nominal_distance, nominal_track,
 from imitwalk.step.style import GaitStyle
 
 #: The format version ``style.json`` is written in (and the newest :meth:`StepGait.load`
-#: reads; a file without one reads as 1).
-GAIT_FORMAT = 1
+#: reads; a file without one reads as 1). 2: the style's ``stride_share`` (a format-1
+#: style walks all of its clip's stride).
+GAIT_FORMAT = 2
 
 __all__ = ["GAIT_FORMAT", "StepGait"]
 

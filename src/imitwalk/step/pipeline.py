@@ -2,11 +2,13 @@
 
 :func:`learn_clip` takes a :class:`~imitwalk.mocap.Motion` and a robot to a finished run
 folder: the clip's gait template (:mod:`imitwalk.retarget.template`), its style on the
-robot's legs (:mod:`imitwalk.step.style`), the gains learned on training robots
+robot's legs (:mod:`imitwalk.step.style`), the stride its servos carry
+(:mod:`imitwalk.step.pace`), the gains learned on training robots
 (:mod:`imitwalk.step.learn`), and the run's records:
 
 RUN_DIR/
-  config.json   ``learner: "step"``, the learning settings, the clip
+  config.json   ``learner: "step"``, the learning settings, the clip, the stride's
+                choice (:mod:`imitwalk.step.pace`)
   style.json    the gait (:class:`~imitwalk.step.gait.StepGait`)
   cma.pkl       the optimiser after every generation (resume)
   log.jsonl     one line per generation
@@ -31,6 +33,7 @@ from imitwalk.runs import LearnSummary, RunDir, StepOutcome
 from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
+from imitwalk.step.pace import PACE_PROTOCOL, choose_stride
 
 if TYPE_CHECKING:
     from imitwalk.mocap import Motion
@@ -103,9 +106,18 @@ def learn_clip(
     else:
         if rd.exists("config.json") or rd.exists("checkpoint.json"):
             raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        # the stride first: the run's files are written once it is chosen, so a run
+        # stopped here is started again, not resumed
+        from imitwalk.sim.protocol import load_protocol
+
+        trials = load_protocol(PACE_PROTOCOL)
+        style, pace = choose_stride(robot, gait.style, trials, engine=cfg.engine, progress=progress)
+        gait = replace(gait, style=style)
+        config["pace"] = pace.to_dict()
         Path(rd.path).mkdir(parents=True, exist_ok=True)
         rd.write_json("config.json", config)
         gait.save(rd.file("style.json"))
+    paced = dict(rd.read_json("config.json").get("pace") or {})
     res = learn_step(robot, gait.style, cfg, out, protocol, resume=resume, progress=progress)
     rd.write_json("gains.json", {"learned": res.gains.to_dict(), "default": StepGains().to_dict()})
     summary = LearnSummary(
@@ -113,10 +125,10 @@ def learn_clip(
         scale_reached=1.0,
         scales_passed=[1.0],
         iterations=len(res.history),
-        sim_seconds_used_for_learning=res.sim_seconds,
+        sim_seconds_used_for_learning=res.sim_seconds + float(paced.get("sim_seconds", 0.0)),
         wall_seconds_for_learning=max(res.wall_seconds, time.perf_counter() - t0),
         config=cfg.to_dict(),
-        outcome=StepOutcome(gains=res.gains.to_dict(), final=res.final),
+        outcome=StepOutcome(gains=res.gains.to_dict(), final=res.final, pace=paced or None),
     )
     rd.write_json("metrics.json", summary.to_dict())
     return summary

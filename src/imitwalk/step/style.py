@@ -15,7 +15,7 @@ What the robot adds is its own: the step width (its hips' spacing), the pelvis h
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -34,6 +34,7 @@ __all__ = [
     "GaitStyle",
     "hip_height",
     "style_from_template",
+    "with_stride",
 ]
 
 #: The stance knee keeps at least this flexion at the nominal step [deg]: a position-
@@ -68,7 +69,9 @@ class GaitStyle:
             ``turn_deg``: its turn per cycle [deg]); geometry: the robot's leg measures;
             turn: the heading change per gait cycle [rad], + left (0: a straight walk):
             the clip's (:attr:`GaitTemplate.turn_deg
-            <imitwalk.retarget.template.GaitTemplate.turn_deg>`), at most :data:`MAX_TURN`.
+            <imitwalk.retarget.template.GaitTemplate.turn_deg>`), at most :data:`MAX_TURN`;
+        stride_share: the share of the clip's (leg-scaled) stride walked: 1, or less where
+            the robot's servos cannot carry the clip's swing (:mod:`imitwalk.step.pace`).
     """
 
     step_time: float
@@ -83,6 +86,7 @@ class GaitStyle:
     human: dict
     geometry: LegGeometry
     turn: float = 0.0
+    stride_share: float = 1.0
 
     @property
     def pelvis_height(self) -> float:
@@ -193,4 +197,19 @@ def style_from_template(
         },
         geometry=geom,
         turn=float(np.clip(np.radians(clip_turn), -MAX_TURN, MAX_TURN)),
+    )
+
+
+def with_stride(style: GaitStyle, share: float) -> GaitStyle:
+    """``style`` walking ``share`` (0 < share <= 1) of the clip's stride, its hips as high
+    as that step allows (:func:`hip_height`); cadence, clearance, swing shape and arms
+    unchanged. ``share`` is of the clip's stride, not of ``style``'s."""
+    if not 0.0 < share <= 1.0:
+        raise ConfigError(f"stride share {share:g}: expected 0 < share <= 1")
+    length = style.step_length / style.stride_share * share
+    return replace(
+        style,
+        step_length=float(length),
+        hip_height=hip_height(style.geometry, max(length, 1e-6)),
+        stride_share=float(share),
     )
