@@ -154,7 +154,7 @@ def test_a_loaded_controller_imports_only_numpy_and_mujoco_and_never_steps_physi
 
 def test_the_manifest_says_what_a_robot_needs(export, robot):
     m = json.loads((export / "manifest.json").read_text())
-    assert m["format"] == 1 and m["controller"] == "stepping"
+    assert m["format"] == 2 and m["controller"] == "stepping"
     assert [j["name"] for j in m["joints"]] == list(robot.joint_names)
     assert m["control"]["rate_hz"] == pytest.approx(100.0)
     blocks = {b["name"]: b for b in m["sensors"]["blocks"]}
@@ -182,8 +182,10 @@ def _damage(folder, how: str) -> str:
         return "style.json"
     m = json.loads(m_path.read_text())
     if how == "newer format":
-        m["format"] = 2
-        word = "format 2"
+        from imitwalk.runtime.bundle import BUNDLE_FORMAT
+
+        m["format"] = BUNDLE_FORMAT + 1
+        word = f"format {BUNDLE_FORMAT + 1}"
     elif how == "another kind":
         m["kind"] = "something else"
         word = "kind"
@@ -219,6 +221,24 @@ def test_a_damaged_export_is_refused_in_one_line(export, tmp_path, how):
         Controller.load(bad)
     msg = str(err.value)
     assert word in msg and "\n" not in msg
+
+
+def test_a_format_1_export_walks_its_whole_stride(export, tmp_path):
+    """An export of 0.7.0 (format 1: its style has no ``stride_share``) still loads."""
+    import hashlib
+
+    from imitwalk.runtime.bundle import read_bundle
+
+    old = tmp_path / "old"
+    shutil.copytree(export, old)
+    style = json.loads((old / "style.json").read_text())
+    del style["stride_share"]
+    (old / "style.json").write_text(json.dumps(style))
+    m = json.loads((old / "manifest.json").read_text())
+    m["format"] = 1
+    m["files"]["style.json"] = hashlib.sha256((old / "style.json").read_bytes()).hexdigest()
+    (old / "manifest.json").write_text(json.dumps(m))
+    assert read_bundle(old).style.stride_share == 1.0
 
 
 @pytest.mark.parametrize(

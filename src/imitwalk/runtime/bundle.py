@@ -57,8 +57,9 @@ __all__ = [
     "write_bundle",
 ]
 
-#: The format version of an export written here (and the newest read).
-BUNDLE_FORMAT = 1
+#: The format version of an export written here (and the newest read). 2: the stepping
+#: gait's style carries its ``stride_share`` (a format-1 style walks its whole stride).
+BUNDLE_FORMAT = 2
 #: The manifest's file name, and the value of its ``"kind"`` key.
 MANIFEST, KIND = "manifest.json", "imitwalk controller"
 #: The controllers an export holds: the stepping gait, or a PPO policy (on the stepping
