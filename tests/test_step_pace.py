@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as hs
 
 from imitwalk.cli.main import main
-from imitwalk.errors import ConfigError
+from imitwalk.errors import ConfigError, RunError
 from imitwalk.robots import load_robot
 
 
@@ -158,6 +158,11 @@ def test_a_paced_gait_saves_its_share_and_an_older_file_walks_the_whole_stride(
     del d["style"]["stride_share"]
     (tmp_path / "old.json").write_text(json.dumps(d))
     assert StepGait.load(tmp_path / "old.json").style.stride_share == 1.0
+    d["format"], d["style"]["stride_share"] = 2, 1.5
+    (tmp_path / "bad.json").write_text(json.dumps(d))
+    with pytest.raises(RunError, match="expected 0 < stride_share <= 1") as err:
+        StepGait.load(tmp_path / "bad.json")
+    assert "\n" not in str(err.value)
 
 
 @pytest.mark.slow

@@ -124,8 +124,11 @@ class GaitStyle:
 
     @classmethod
     def from_dict(cls, d: dict) -> GaitStyle:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (a ``stride_share`` outside (0, 1]: ValueError)."""
         d = dict(d)
+        share = float(d.get("stride_share", 1.0))
+        if not 0.0 < share <= 1.0:
+            raise ValueError(f"stride_share {share:g}: expected 0 < stride_share <= 1")
         d["swing_x"] = np.asarray(d["swing_x"], dtype=float)
         d["swing_z"] = np.asarray(d["swing_z"], dtype=float)
         d["upper"] = {k: np.asarray(v, dtype=float) for k, v in d["upper"].items()}
