@@ -31,7 +31,7 @@ is most of it), so the ratio says when to try shorter strides but cannot pick on
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -84,13 +84,7 @@ class PaceChoice:
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary."""
-        return {
-            "ratio": self.ratio,
-            "share": self.share,
-            "robots": self.robots,
-            "trials": dict(self.trials),
-            "sim_seconds": self.sim_seconds,
-        }
+        return asdict(self)
 
 
 def top_speeds(robot: Robot) -> np.ndarray:
@@ -140,7 +134,7 @@ def servo_ratio(robot: Robot, style: GaitStyle) -> float:
 def choose_stride(
     robot: Robot,
     style: GaitStyle,
-    protocol: Protocol,
+    protocol: Protocol | None = None,
     seconds: float = PACE_SECONDS,
     engine: str = "mujoco",
     gains: StepGains | None = None,
@@ -149,13 +143,17 @@ def choose_stride(
     """``style`` at the stride its servos carry, and how it was chosen (see the module
     doc): as it is if :func:`servo_ratio` is at most 1; else the strides of
     :data:`STRIDES`, longest first until one fells none, each walk :data:`PACE_ROBOTS`
-    robots of ``protocol`` (the one :data:`PACE_PROTOCOL` names; seeds from
+    robots of ``protocol`` (default: the one :data:`PACE_PROTOCOL` names; seeds from
     :data:`~imitwalk.sim.seeds.TRIAL_FIRST`) for ``seconds`` [s] with ``gains`` (default:
     the shipped ones); the longest with the fewest falls is kept."""
     say = progress or (lambda _msg: None)
     ratio = servo_ratio(robot, style)
     if ratio <= 1.0:
         return style, PaceChoice(ratio=ratio, share=style.stride_share)
+    if protocol is None:
+        from imitwalk.sim.protocol import load_protocol
+
+        protocol = load_protocol(PACE_PROTOCOL)
     gains = gains or StepGains()
     draws = [protocol.draw(TRIAL_FIRST + i, robot, seconds=seconds) for i in range(PACE_ROBOTS)]
     styles, falls, walked = [], [], 0.0

@@ -33,7 +33,7 @@ from imitwalk.runs import LearnSummary, RunDir, StepOutcome
 from imitwalk.step.gains import StepGains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
-from imitwalk.step.pace import PACE_PROTOCOL, choose_stride
+from imitwalk.step.pace import choose_stride
 
 if TYPE_CHECKING:
     from imitwalk.mocap import Motion
@@ -108,10 +108,7 @@ def learn_clip(
             raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
         # the stride first: the run's files are written once it is chosen, so a run
         # stopped here is started again, not resumed
-        from imitwalk.sim.protocol import load_protocol
-
-        trials = load_protocol(PACE_PROTOCOL)
-        style, pace = choose_stride(robot, gait.style, trials, engine=cfg.engine, progress=progress)
+        style, pace = choose_stride(robot, gait.style, engine=cfg.engine, progress=progress)
         gait = replace(gait, style=style)
         config["pace"] = pace.to_dict()
         Path(rd.path).mkdir(parents=True, exist_ok=True)
