@@ -10,11 +10,7 @@ need to hold them:
 * the **servo feedforward**, a fraction of ``(τ + kv q̇) / kp``: the static torques of
   the planned support (the weight pressing at the pendulum's ZMP,
   :meth:`~imitwalk.step.kinematics.BodyModel.static_torques`) and the servos' damping
-  along the planned joint velocity (the computed-torque feedforward of a PD servo),
-  that velocity held within :data:`FEEDFORWARD_SPEED` × the gait's angular frequency
-  ``2π / (2 · step time)``: the leg IK leaves a straight trailing knee in jumps of
-  20–30° a tick at lift-off, which read as 40 rad/s and asked hoap2's swing knee for
-  up to 110° more than its target;
+  along the planned joint velocity (the computed-torque feedforward of a PD servo);
 * the **ankles' share of the balance**: a ZMP shift ``Δp`` asks each loaded ankle for
   ``m g Δp`` of torque, ``Δθ = m g Δp / kp`` (pitch for x, roll for y).
 """
@@ -29,13 +25,7 @@ from imitwalk.step.kinematics import BodyModel, FootPose, rot_z
 from imitwalk.step.lipm import GRAVITY
 from imitwalk.step.style import GaitStyle
 
-__all__ = ["FEEDFORWARD_SPEED", "JointSolver"]
-
-#: The joint speed fed forward is held within this many radians × the gait's angular
-#: frequency [rad]. Picked by trials on the 40 training robots of ``hard`` (seeds
-#: 1001-1040, default clip, hoap2, its learned gains): falls 24 with none held, 21 at
-#: 2, 16 at 1, 15 at 0.5, 18 with no speed fed forward at all.
-FEEDFORWARD_SPEED = 1.0
+__all__ = ["JointSolver"]
 
 
 class JointSolver:
@@ -54,7 +44,6 @@ class JointSolver:
         geom = style.geometry
         self.half = np.array([geom.foot_length, geom.foot_width]) / 2
         self._upper = {r: robot.index(r) for r in style.upper if r in robot.joint_names}
-        self.top_qdot = FEEDFORWARD_SPEED * np.pi / style.step_time  # [rad/s]
         self.reset(robot.stand)
 
     def reset(self, q: np.ndarray) -> None:
@@ -128,7 +117,6 @@ class JointSolver:
         g = self.gains
         if g.feedforward:  # the servos' static sag, and their damping's lag: τ = kp e − kv q̇
             qdot = (q - self.q_prev) / self.dt
-            qdot = np.minimum(np.maximum(qdot, -self.top_qdot), self.top_qdot)
             out += g.feedforward * self.ik.kv * qdot / self.kp
             pressed = {s: (share, at - pelvis) for s, (share, at) in loads.items()}
             out += g.feedforward * self.ik.static_torques(pressed) / self.kp
