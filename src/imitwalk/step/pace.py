@@ -44,7 +44,7 @@ from imitwalk.step.gains import StepGains
 from imitwalk.step.kinematics import BodyModel, FootPose
 from imitwalk.step.style import GaitStyle, with_stride
 
-if TYPE_CHECKING:  # the caller loads the protocol (its draws need SciPy)
+if TYPE_CHECKING:  # loaded in choose_stride only when trials walk (its draws need SciPy)
     from imitwalk.sim.protocol import Protocol
 
 __all__ = [
