@@ -35,7 +35,11 @@ def measure(path: str, seconds: float) -> dict:
         lifted_s=0.5 * st.single_support,
     )
     human = st.human
-    speed = None if timing.stride_m is None else timing.stride_m / timing.cycle_s
+    # the soles' stride is a distance and a backward walk's style (learn --backward) is
+    # negative: the robot's is signed the way it walked
+    way = -1.0 if st.step_length < 0 else 1.0
+    stride = None if timing.stride_m is None else way * timing.stride_m
+    speed = None if stride is None else stride / timing.cycle_s
     out = {
         "clip": gait.source,
         "fell": m.fell,
@@ -53,7 +57,7 @@ def measure(path: str, seconds: float) -> dict:
         },
         "robot": {
             "cadence_spm": timing.cadence_spm,
-            "stride_m": timing.stride_m,
+            "stride_m": stride,
             "speed_mps": speed,
             "steps": timing.steps,
             "scuffs": timing.scuffs,

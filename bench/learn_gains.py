@@ -11,8 +11,13 @@ OUT after every generation (``--resume``). The shipped gains came from
 run of an earlier revision, resumed: the optimiser's draws after the resume differ from
 an uninterrupted run's, so a rerun learns gains of the same quality, not the same gains).
 
-Usage: ``python bench/learn_gains.py OUT [CLIP ...] [--resume] [--start GAINS.json]``;
-prints JSON.
+``--backward`` learns the clips played backward in time (``learn --backward``): the
+shipped backward gains (:data:`~imitwalk.step.gains.BACKWARD`) are what a default
+``imitwalk learn --backward`` kept on the embedded walk (G); ``--backward --start G.json
+--generations 10 --population 10 --robots 6 --seconds 10 --final 16`` kept G too.
+
+Usage: ``python bench/learn_gains.py OUT [CLIP ...] [--backward] [--resume] [--start
+GAINS.json]``; prints JSON.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ def main() -> None:
     ap.add_argument("out")
     ap.add_argument("clips", nargs="*", help="mocap files (default: the embedded walk)")
     ap.add_argument("--resume", action="store_true")
+    ap.add_argument("--backward", action="store_true", help="the clips played backward")
     ap.add_argument("--start", help="a JSON file of gains to start from (default: shipped)")
     ap.add_argument("--generations", type=int, default=25)
     ap.add_argument("--population", type=int, default=12)
@@ -42,7 +48,10 @@ def main() -> None:
     ap.add_argument("--sigma", type=float, default=0.2)
     args = ap.parse_args()
     robot = load_robot("hoap2")
-    styles = [gait_from_motion(load_motion(c), robot).style for c in args.clips or [default_clip()]]
+    styles = [
+        gait_from_motion(load_motion(c), robot, backward=args.backward).style
+        for c in args.clips or [default_clip()]
+    ]
     names = tuple(n for n in BOUNDS if n != "heading")
     cfg = StepLearnConfig(
         robots=args.robots,

@@ -148,6 +148,16 @@ def test_navigate_writes_its_verdict_plot_and_video(step_run, tmp_path, capsys):
 
 
 def test_bad_navigate_commands_exit_2_with_one_line(step_run, tick_run, tmp_path, capsys):
+    import shutil
+    from dataclasses import replace
+
+    from imitwalk.step.gait import StepGait
+    from imitwalk.step.style import reversed_in_time
+
+    back = tmp_path / "back"  # a backward run (learn --backward)
+    shutil.copytree(step_run, back)
+    gait = StepGait.load(back / "style.json")
+    replace(gait, style=reversed_in_time(gait.style)).save(back / "style.json")
     base = ["navigate", str(step_run), "--no-video", "--out", str(tmp_path / "n")]
     cases = [
         ([*base, "--waypoints", "1,nan"], "waypoint 1 '1,nan'"),
@@ -157,6 +167,7 @@ def test_bad_navigate_commands_exit_2_with_one_line(step_run, tick_run, tmp_path
         ([*base, "--fix-rate", "-1"], "rate"),
         ([*base, "--seeds", "0"], "--seeds 0"),
         (["navigate", str(tick_run), "--no-video"], "learner: step"),
+        (["navigate", str(back), "--no-video"], "walks backward"),
         (["navigate", str(tmp_path / "none")], "not found"),
     ]
     for argv, word in cases:

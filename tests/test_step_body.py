@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from imitwalk.errors import ConfigError
 from imitwalk.step.gains import BOUNDS, StepGains
 from imitwalk.step.kinematics import BodyModel, FootPose, floor_mat, rot_z
-from imitwalk.step.style import GaitStyle, hip_height, style_from_template
+from imitwalk.step.style import GaitStyle, hip_height, reversed_in_time, style_from_template
 
 
 @pytest.fixture(scope="module")
@@ -38,6 +38,59 @@ def test_the_style_keeps_the_cadence_and_scales_the_stride(template, geom):
     back = GaitStyle.from_dict(st.to_dict())
     assert back.step_length == st.step_length and np.array_equal(back.swing_x, st.swing_x)
     assert back.geometry == st.geometry
+
+
+@pytest.mark.parametrize("scale", [0.5, 1.0])
+def test_the_style_reversed_in_time_walks_the_same_steps_backward(template, geom, scale):
+    """The clip played backward: the same cadence, double support, clearance and hips,
+    the step negated, the swing retracing its path (its progress still 0 → 1, non-
+    decreasing), the turn negated; reversed twice, the style comes back."""
+    st = style_from_template(template, geom, scale)
+    back = reversed_in_time(st)
+    assert back.step_length == -st.step_length and back.speed == -st.speed
+    for name in ("step_time", "double_support", "clearance", "hip_height", "step_width"):
+        assert getattr(back, name) == getattr(st, name)
+    assert back.swing_x[0] == pytest.approx(0.0) and back.swing_x[-1] == pytest.approx(1.0)
+    assert np.all(np.diff(back.swing_x) >= -1e-12)
+    assert np.allclose(back.swing_z, st.swing_z[::-1])
+    twice = reversed_in_time(back)
+    assert np.allclose(twice.swing_x, st.swing_x) and np.allclose(twice.swing_z, st.swing_z)
+    for role, prof in st.upper.items():  # to within the profiles' linear interpolation
+        step = np.max(np.abs(np.diff(np.r_[prof, prof[0]])))
+        assert np.max(np.abs(twice.upper[role] - prof)) <= step + 1e-9
+        assert np.ptp(back.upper[role]) == pytest.approx(np.ptp(prof), abs=step)
+
+
+def test_the_style_reversed_lifts_off_where_the_forward_walk_touched_down(template, geom):
+    """ψ' = 0 (a left touchdown of the backward walk) is the forward walk's left
+    lift-off: the arms there are the forward profile's at ψ = ½ + the double support's
+    share of the cycle."""
+    st = style_from_template(template, geom, 1.0)
+    back = reversed_in_time(st)
+    off = 0.5 + st.double_support / (2 * st.step_time)
+    fwd = st.upper_at(off)
+    for role, value in back.upper_at(0.0).items():
+        assert value == pytest.approx(fwd[role])
+    later = st.upper_at(off - 0.1)  # a tenth of a cycle on backward is a tenth earlier
+    for role, value in back.upper_at(0.1).items():
+        assert value == pytest.approx(later[role], abs=0.02)
+
+
+def test_a_backward_walk_plans_its_steps_behind_with_the_zmp_rolling_toe_to_heel(template, geom):
+    from imitwalk.step.nominal import NominalWalk
+
+    st = style_from_template(template, geom, 1.0)
+    fwd = NominalWalk(st, StepGains(), 4.0, st.pelvis_height)
+    back = NominalWalk(reversed_in_time(st), StepGains(), 4.0, st.pelvis_height)
+    assert back.limits.backward == pytest.approx(fwd.limits.forward)
+    assert back.limits.forward == pytest.approx(fwd.limits.backward)
+    assert back.limits.swing_speed == pytest.approx(fwd.limits.swing_speed)
+    g, b = fwd.gait(5), back.gait(5)
+    assert b.step == pytest.approx(-g.step) and g.step > 0
+    _, heel_f, toe_f = g.zmp_points(1.0)
+    _, heel_b, toe_b = b.zmp_points(1.0)
+    assert toe_f[0] > heel_f[0] and toe_b[0] < heel_b[0]  # the ZMP rolls the way it walks
+    assert back.offset(5, 1.0)[0] == pytest.approx(-fwd.offset(5, 1.0)[0])
 
 
 def test_a_step_beyond_the_legs_is_refused_naming_the_limit(geom):

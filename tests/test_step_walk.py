@@ -46,6 +46,42 @@ def test_the_nominal_robot_walks_the_style_from_its_sensors_alone(robot, gait):
     assert set(seen) == {"Observation"}
 
 
+def test_the_clip_played_backward_walks_backward_from_the_sensors(robot, gait):
+    """The style reversed in time, with the shipped backward gains, walks the nominal
+    robot backward at the clip's whole stride for eight seconds, and is judged by its own
+    (negative) distance."""
+    from imitwalk.sim.metrics import walk_metrics
+    from imitwalk.sim.mujoco import MujocoPlant, run
+    from imitwalk.step.controller import SteppingController
+    from imitwalk.step.gains import shipped_gains
+    from imitwalk.step.style import reversed_in_time
+
+    style = reversed_in_time(gait.style)
+    ctrl = SteppingController(robot, style, shipped_gains(backward=True), gait.dt)
+    ro = run(MujocoPlant(robot), ctrl, 800)
+    m = walk_metrics(ro, style.speed * ro.seconds)
+    assert not m.fell and ctrl.steps >= 8
+    assert m.forward_distance_m < -0.5 and 0.6 < m.progress_ratio < 1.2
+
+
+def test_learn_backward_writes_a_backward_run_that_resumes_as_one(tmp_path, capsys):
+    from imitwalk.cli.main import main
+    from imitwalk.step.gains import shipped_gains
+    from imitwalk.step.gait import StepGait
+
+    out = tmp_path / "back"
+    assert main(["learn", "--backward", "--out", str(out), "--json", *sets(TINY_STEP)]) == 0
+    capsys.readouterr()
+    first = StepGait.load(out / "style.json").style
+    assert first.step_length < 0
+    # its default controller (and the search's start) is the shipped backward gains
+    default = json.loads((out / "gains.json").read_text())["default"]
+    assert default == shipped_gains(backward=True).to_dict() != shipped_gains().to_dict()
+    # resumed (without --backward), the run walks its own style
+    assert main(["learn", "--out", str(out), "--resume", "--json", *sets(TINY_STEP)]) == 0
+    assert StepGait.load(out / "style.json").style.step_length == first.step_length
+
+
 @pytest.mark.parametrize("deg", [-3.0, 3.0])
 def test_the_soles_laid_onto_the_floor_carry_the_gait_across_a_slope(robot, gait, deg):
     """A floor tilted 3° across the walk fell the gait while its soles stayed level
@@ -132,6 +168,12 @@ def test_learn_and_evaluate_a_stepping_run_through_the_cli(tmp_path, capsys):
     # a stepping run refuses the joint-space learner's flags, in one line
     assert main(["learn", "--out", str(tmp_path / "x"), "--turn", "10"]) == 2
     assert "--turn" in capsys.readouterr().err
+    # ... and the joint-space learners refuse --backward
+    argv = ["learn", "--out", str(tmp_path / "y"), "--variant", "extended", "--backward"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: --backward") and "\n" not in err
+    assert not (tmp_path / "y").exists()
 
 
 @pytest.mark.parametrize(

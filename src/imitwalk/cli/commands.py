@@ -113,6 +113,10 @@ def learn(args: argparse.Namespace) -> int:
     args.variant = _variant(args)
     if args.variant == "step":
         return _learn_step(args, robot)
+    if getattr(args, "backward", False):
+        from imitwalk.errors import ConfigError
+
+        raise ConfigError(f"--backward: a stepping-gait option, not --variant {args.variant}'s")
     rt_set, learn_set = _split_settings(args.set)
     cfg, run = _joint_space_learner(args, learn_set)
     rd = RunDir(args.out)
@@ -247,7 +251,16 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
         f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "
         f"(at most {cfg.budget():.0f} simulated seconds)"
     )
-    summary = learn(motion, robot, args.out, cfg, args.resume, progress, recorded_robot(args))
+    summary = learn(
+        motion,
+        robot,
+        args.out,
+        cfg,
+        args.resume,
+        progress,
+        recorded_robot(args),
+        backward=bool(getattr(args, "backward", False)),
+    )
     return _learned(summary, args, rd)
 
 

@@ -198,6 +198,11 @@ def _add_learn(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "the joint trajectory replayed with per-tick balance learned by trials and the "
         "paper's loop (the default with --reference); faithful: the paper as written",
     )
+    ln.add_argument(
+        "--backward",
+        action="store_true",
+        help="the stepping gait: learn the clip played backward in time, a backward walk",
+    )
     ln.add_argument("--seed", type=int, default=0, help="random seed (0)")
     ln.add_argument("--resume", action="store_true", help="continue an interrupted run")
     ln.add_argument(

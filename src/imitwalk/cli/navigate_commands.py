@@ -121,6 +121,7 @@ def _stepping_run(args: argparse.Namespace) -> tuple[RunDir, LoadedRun, Robot]:
     from imitwalk.errors import ConfigError
     from imitwalk.judge.replay import load_run
     from imitwalk.runs import RunDir
+    from imitwalk.step.gait import StepGait
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
@@ -128,6 +129,10 @@ def _stepping_run(args: argparse.Namespace) -> tuple[RunDir, LoadedRun, Robot]:
     if lr.learner != "step":
         raise ConfigError(
             f"{rd.path} is a {lr.learner!r} run; navigate steers the stepping gait (learner: step)"
+        )
+    if isinstance(lr.ref, StepGait) and lr.ref.style.step_length < 0:
+        raise ConfigError(
+            f"{rd.path} walks backward (learn --backward); navigate steers a forward walk"
         )
     return rd, lr, _robot(args, rd, cfg)
 

@@ -132,7 +132,7 @@ def walk_metrics(
     tail = max(1, int(round(1.0 / rollout.control_dt)))
     yaw_drift = float(np.degrees(np.mean(yaw[-tail:] - cmd[-tail:, 2]) - head))
     whole = track[-1] if track is not None and len(track) else cmd[-1]  # (3,) commanded
-    if expected_distance > 0:
+    if expected_distance != 0:  # negative: a backward walk
         progress = fwd / expected_distance
     elif abs(whole[2]) > 0:  # a turn on the spot: how much of the whole turn was made
         progress = _share(np.radians(yaw_drift), cmd[-1, 2], whole[2])

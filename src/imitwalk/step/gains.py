@@ -8,7 +8,9 @@ training robots of the ``hard`` protocol drawn from seed 1001 on, new robots eve
 generation; the default clip on ``hoap2``), then the best of the generations' winners
 on 16 fresh robots (``python bench/learn_gains.py OUT``; 17,900 simulated seconds,
 16 minutes on 2 cores). They are the ``default`` controller of every stepping run and
-where ``imitwalk learn`` starts from. ``heading`` is the learner's start, a half.
+where ``imitwalk learn`` starts from. ``heading`` is the learner's start, a half. A
+backward walk (``learn --backward``) ships its own, :data:`BACKWARD`
+(:func:`shipped_gains` gives either).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["BOUNDS", "GainRange", "StepGains"]
+__all__ = ["BACKWARD", "BOUNDS", "GainRange", "StepGains", "shipped_gains"]
 
 
 class GainRange(NamedTuple):
@@ -121,3 +123,39 @@ class StepGains:
             lo, hi, _ = BOUNDS[n]
             d[n] = float(lo + (hi - lo) * v)
         return StepGains(**d)
+
+
+#: The shipped gains of a backward walk (a style played backward in time, ``imitwalk
+#: learn --backward``): what ``learn --backward`` kept on the embedded walk from the
+#: forward walk's shipped gains (0 of 40 ``eval`` robots fall with them, against 40 with
+#: the forward ones). A longer search from them (``python bench/learn_gains.py OUT
+#: --backward --start G.json --generations 10 --population 10 --robots 6 --seconds 10
+#: --final 16``, 3,279 simulated seconds) kept them: 7 of 16 fresh ``hard`` robots fell,
+#: 10 or more with every generation's winner.
+BACKWARD = StepGains(
+    dcm=4.230,
+    ankle=4.484,
+    follow=0.05306,
+    lead=0.04590,
+    step_weight=-0.3759,
+    time_weight=1.014,
+    zmp_weight=-2.611,
+    unload=0.4480,
+    ss_min=0.7577,
+    zmp_roll=0.1804,
+    zmp_out=0.003451,
+    support=0.7538,
+    plan_support=0.2765,
+    crouch=0.001856,
+    heading=0.3326,
+    observer=0.8430,
+    swing_fix=27.67,
+    feedforward=0.7553,
+)
+
+
+def shipped_gains(backward: bool = False) -> StepGains:
+    """The gains imitwalk ships: the ``default`` controller of a stepping run and where
+    its ``learn`` starts, for a forward walk (:class:`StepGains`'s defaults) or a
+    backward one (:data:`BACKWARD`)."""
+    return BACKWARD if backward else StepGains()

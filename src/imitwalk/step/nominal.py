@@ -3,16 +3,17 @@
 :class:`NominalWalk` turns a style and the gains into the planner's model
 (:mod:`imitwalk.step.planner`): the periodic pendulum walk of each step of the start-up
 and after it (:class:`~imitwalk.step.lipm.NominalGait`: the style's stride, width and
-timing; the ZMP rolling heel to toe by ``zmp_roll`` of the half sole and set ``zmp_out``
+timing; the ZMP rolling heel to toe by ``zmp_roll`` of the half sole (toe to heel in
+a backward walk, :func:`~imitwalk.step.style.reversed_in_time`) and set ``zmp_out``
 of the half sole outside the centre line), its DCM offsets at touchdown, the steps'
 limits and the planner's weights.
 
 The limits come from the robot's legs (:class:`~imitwalk.retarget.params.LegGeometry`):
 a step reaches at most as far as both legs, nearly straight, reach from hips midway
-between the feet at the walking height; the feet stay a tenth of a sole's width apart
-at least, and at most 0.4 of a leg wider than the style's width; a single support lasts
-``ss_min`` to 1.5 times the style's; the swing foot moves at most four times its
-nominal speed.
+between the feet at the walking height (half that against the walk's direction); the
+feet stay a tenth of a sole's width apart at least, and at most 0.4 of a leg wider than
+the style's width; a single support lasts ``ss_min`` to 1.5 times the style's; the swing
+foot moves at most four times its nominal speed.
 """
 
 from __future__ import annotations
@@ -48,14 +49,16 @@ class NominalWalk:
         hip = pelvis_z - geom.hip_z - geom.ankle  # the hips over the ankles [m]
         reach = geom.leg * 0.99
         far = 2 * np.sqrt(max(reach**2 - hip**2, 0.0))  # both legs reaching, hips midway
+        ahead, behind = (far, 0.5 * far) if style.step_length >= 0 else (0.5 * far, far)
+        length = abs(style.step_length)
         self.limits = StepLimits(
-            forward=max(far, style.step_length),
-            backward=0.5 * far,
+            forward=max(ahead, style.step_length),
+            backward=max(behind, -style.step_length),
             inner=geom.foot_width + 0.1 * geom.foot_width,
             outer=style.step_width + 0.4 * geom.leg,
             ss_min=gains.ss_min * style.single_support,
             ss_max=1.5 * style.single_support,
-            swing_speed=4.0 * max(style.step_length, style.step_width) / style.single_support + 0.2,
+            swing_speed=4.0 * max(length, style.step_width) / style.single_support + 0.2,
         )
         self.weights = StepWeights(
             10.0**gains.step_weight, 1.0, 10.0**gains.time_weight, 10.0**gains.zmp_weight
@@ -71,7 +74,8 @@ class NominalWalk:
         k = (min(step, START_STEPS), stride)
         if k not in self._gaits:
             st, g = self.style, self.gains
-            roll = g.zmp_roll * self.half[0]
+            # the ZMP rolls the way the walk goes: heel to toe, or toe to heel backward
+            roll = g.zmp_roll * self.half[0] * (1.0 if st.step_length >= 0 else -1.0)
             self._gaits[k] = NominalGait(
                 step=stride * stride_at(k[0], st.step_length),
                 width=st.step_width,

@@ -30,7 +30,7 @@ from imitwalk.errors import MocapError, RunError
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir, StepOutcome
-from imitwalk.step.gains import StepGains
+from imitwalk.step.gains import shipped_gains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
 from imitwalk.step.pace import choose_stride
@@ -44,12 +44,17 @@ __all__ = ["gait_from_motion", "learn", "learn_clip"]
 
 
 def gait_from_motion(
-    motion: Motion, robot: Robot, named: Provenance | None = None, dt: float = 0.01
+    motion: Motion,
+    robot: Robot,
+    named: Provenance | None = None,
+    dt: float = 0.01,
+    backward: bool = False,
 ) -> StepGait:
     """The :class:`~imitwalk.step.gait.StepGait` of ``motion`` on ``robot`` at scale 1:
     of its straight cycles, or if it has none, of its turning ones (a turning gait, its
     turn per cycle read from the clip: :attr:`~imitwalk.retarget.template.GaitTemplate.turn_deg`).
-    ``named``: the robot as the command named it (default: its name).
+    ``named``: the robot as the command named it (default: its name); ``backward``: the
+    clip played backward in time (:func:`~imitwalk.step.style.reversed_in_time`).
 
     Raises:
         MocapError: the clip holds no steady walking cycle, straight or turning.
@@ -57,13 +62,15 @@ def gait_from_motion(
     """
     from imitwalk.retarget.ik import leg_geometry
     from imitwalk.retarget.template import extract_template
-    from imitwalk.step.style import style_from_template
+    from imitwalk.step.style import reversed_in_time, style_from_template
 
     try:
         template = extract_template(motion)
     except MocapError:
         template = extract_template(motion, allow_turn=True)
     style = style_from_template(template, leg_geometry(robot), 1.0)
+    if backward:
+        style = reversed_in_time(style)
     return StepGait(
         style=style,
         robot=robot.name,
@@ -103,20 +110,26 @@ def learn_clip(
         if rd.read_json("config.json").get("learn") != cfg.to_dict():
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
         gait = StepGait.load(rd.file("style.json"))
-    else:
+    # the search starts from the shipped gains of the walk's direction
+    start = shipped_gains(backward=gait.style.step_length < 0)
+    if not resume:
         if rd.exists("config.json") or rd.exists("checkpoint.json"):
             raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
         # the stride first: the run's files are written once it is chosen, so a run
         # stopped here is started again, not resumed
-        style, pace = choose_stride(robot, gait.style, engine=cfg.engine, progress=progress)
+        style, pace = choose_stride(
+            robot, gait.style, engine=cfg.engine, gains=start, progress=progress
+        )
         gait = replace(gait, style=style)
         config["pace"] = pace.to_dict()
         Path(rd.path).mkdir(parents=True, exist_ok=True)
         rd.write_json("config.json", config)
         gait.save(rd.file("style.json"))
     paced = dict(rd.read_json("config.json").get("pace") or {})
-    res = learn_step(robot, gait.style, cfg, out, protocol, resume=resume, progress=progress)
-    rd.write_json("gains.json", {"learned": res.gains.to_dict(), "default": StepGains().to_dict()})
+    res = learn_step(
+        robot, gait.style, cfg, out, protocol, resume=resume, progress=progress, start=start
+    )
+    rd.write_json("gains.json", {"learned": res.gains.to_dict(), "default": start.to_dict()})
     summary = LearnSummary(
         learner="step",
         scale_reached=1.0,
@@ -139,9 +152,10 @@ def learn(
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
     named: Provenance | None = None,
+    backward: bool = False,
 ) -> LearnSummary:
     """The product as one call: ``clip`` learned as a stepping gait on ``robot`` into the
-    run folder ``out``, exactly as ``imitwalk learn CLIP --out OUT`` does.
+    run folder ``out``, exactly as ``imitwalk learn CLIP --out OUT [--backward]`` does.
 
     Args:
         clip: a :class:`~imitwalk.mocap.Motion`, a mocap file's or the robot's motion
@@ -150,7 +164,8 @@ def learn(
             file; cfg: the learning settings (default :class:`StepLearnConfig`);
             resume: continue an interrupted run (its clip and gait are its own);
             named: the robot as the command named it, for the run folder (default: its
-            name).
+            name); backward: learn the clip played backward in time (a new run only:
+            a resumed one walks its own style).
     """
     from imitwalk.mocap import Motion, default_clip
     from imitwalk.retarget.motionfiles import load_clip
@@ -164,7 +179,7 @@ def learn(
         gait = StepGait.load(RunDir(out).file("style.json"))
     else:
         motion = clip if isinstance(clip, Motion) else load_clip(clip or default_clip(), robot)
-        gait = gait_from_motion(motion, robot, named)
+        gait = gait_from_motion(motion, robot, named, backward=backward)
         st = gait.style
         if progress is not None:
             progress(

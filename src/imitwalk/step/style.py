@@ -33,6 +33,7 @@ __all__ = [
     "MAX_TURN",
     "GaitStyle",
     "hip_height",
+    "reversed_in_time",
     "style_from_template",
     "with_stride",
 ]
@@ -59,7 +60,8 @@ class GaitStyle:
     Attributes:
         step_time: one step, touchdown to touchdown [s] (half the human's cycle);
         double_support: its double-support time [s]; step_length: forward distance
-            between successive feet [m]; step_width: lateral distance between the feet
+            between successive feet [m] (negative: a backward walk,
+            :func:`reversed_in_time`); step_width: lateral distance between the feet
             [m]; clearance: the swing foot's peak lift [m]; hip_height: hip centre above
             the soles [m]; swing_x, swing_z: ``(P,)`` the swing foot's forward progress
             (0 → 1) and lift (0 → 1 → 0) over the swing; upper: role → ``(P,)`` the arms'
@@ -105,13 +107,7 @@ class GaitStyle:
 
     def upper_at(self, phase: float) -> dict[str, float]:
         """The arms' and waist's offsets [rad] at gait phase ``phase`` (wrapped to [0, 1))."""
-        out = {}
-        for role, prof in self.upper.items():
-            x = (phase % 1.0) * len(prof)
-            i = int(x)
-            f = x - i
-            out[role] = float((1.0 - f) * prof[i % len(prof)] + f * prof[(i + 1) % len(prof)])
-        return out
+        return {role: _cyclic_at(prof, phase) for role, prof in self.upper.items()}
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary (arrays as lists)."""
@@ -186,7 +182,7 @@ def style_from_template(
         step_length=float(step_length),
         step_width=float(2 * geom.hip_y),
         clearance=float(clearance),
-        hip_height=hip_height(geom, max(step_length, 1e-6)),
+        hip_height=hip_height(geom, max(abs(step_length), 1e-6)),
         swing_x=np.asarray(template.swing_x, dtype=float),
         swing_z=shape_z,
         upper=upper,
@@ -213,6 +209,43 @@ def with_stride(style: GaitStyle, share: float) -> GaitStyle:
     return replace(
         style,
         step_length=float(length),
-        hip_height=hip_height(style.geometry, max(length, 1e-6)),
+        hip_height=hip_height(style.geometry, max(abs(length), 1e-6)),
         stride_share=float(share),
     )
+
+
+def reversed_in_time(style: GaitStyle) -> GaitStyle:
+    """``style`` played backward in time: a backward walk, the paper's "stepping backward"
+    module learned from the same clip. Cadence, double support, stride, clearance and
+    pelvis height are the clip's; the step is negative; the swing foot retraces its path
+    (progress ``X'(σ) = 1 − X(1 − σ)``, lift ``Z'(σ) = Z(1 − σ)``); the arms and waist
+    replay their profiles backward, phased so that ψ' = 0 is again a left touchdown
+    (the forward walk's left lift-off, at ψ = ½ + the double support's share of the
+    cycle: ``u'(ψ') = u(ψ_off − ψ')``). Reversing twice gives the style back (the arms'
+    profiles to within their linear interpolation)."""
+    swing_x = 1.0 - style.swing_x[::-1]
+    swing_z = style.swing_z[::-1].copy()
+    off = 0.5 + style.double_support / (2.0 * style.step_time)  # ψ of the left lift-off
+    upper = {}
+    for role, prof in style.upper.items():
+        prof = np.asarray(prof, dtype=float)
+        p = len(prof)
+        psi = (off - np.arange(p) / p) % 1.0  # where ψ' = k / p reads the forward profile
+        upper[role] = np.array([_cyclic_at(prof, x) for x in psi])
+    return replace(
+        style,
+        step_length=-style.step_length,
+        swing_x=swing_x,
+        swing_z=swing_z,
+        upper=upper,
+        turn=-style.turn,
+    )
+
+
+def _cyclic_at(prof: np.ndarray, phase: float) -> float:
+    """The cyclic profile ``prof`` ``(P,)`` (sampled at ψ = k / P) at ``phase``, linearly
+    interpolated."""
+    x = (phase % 1.0) * len(prof)
+    i = int(x)
+    f = x - i
+    return float((1.0 - f) * prof[i % len(prof)] + f * prof[(i + 1) % len(prof)])
