@@ -116,7 +116,10 @@ def learn(args: argparse.Namespace) -> int:
     if getattr(args, "backward", False):
         from imitwalk.errors import ConfigError
 
-        raise ConfigError(f"--backward: a stepping-gait option, not --variant {args.variant}'s")
+        raise ConfigError(
+            f"--backward: only --variant step (the stepping gait) walks backward, "
+            f"not {args.variant}"
+        )
     rt_set, learn_set = _split_settings(args.set)
     cfg, run = _joint_space_learner(args, learn_set)
     rd = RunDir(args.out)

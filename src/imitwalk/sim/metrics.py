@@ -103,10 +103,10 @@ def walk_metrics(
     Args:
         rollout: a :class:`~imitwalk.sim.types.Rollout`.
         expected_distance: distance the reference commands [m] (the denominator of
-            ``progress_ratio``): over the duration the walk is judged on, the rollout's
-            own (a learner's or a search's walk, which may end early on purpose) or the
-            whole duration asked for (``evaluate``: a fall then scores the share of the
-            whole walk made).
+            ``progress_ratio``; negative for a backward walk): over the duration the walk
+            is judged on, the rollout's own (a learner's or a search's walk, which may end
+            early on purpose) or the whole duration asked for (``evaluate``: a fall then
+            scores the share of the whole walk made).
         q_ref: ``(N, n)`` reference joint angles to compare the measured ones with;
             defaults to the commanded targets.
         track: ``(T, 3)`` the commanded forward and sideways travel [m] and heading

@@ -127,7 +127,7 @@ class StepGains:
 
 #: The shipped gains of a backward walk (a style played backward in time, ``imitwalk
 #: learn --backward``): what ``learn --backward`` kept on the embedded walk from the
-#: forward walk's shipped gains (0 of 40 ``eval`` robots fall with them, against 40 with
+#: forward walk's shipped gains (0 of 40 ``eval`` robots fall with them; 10 of 10 with
 #: the forward ones). A longer search from them (``python bench/learn_gains.py OUT
 #: --backward --start G.json --generations 10 --population 10 --robots 6 --seconds 10
 #: --final 16``, 3,279 simulated seconds) kept them: 7 of 16 fresh ``hard`` robots fell,
