@@ -220,3 +220,27 @@ def test_report_in_a_real_browser(request, browser, which, tmp_path):
     assert video["error"] is None and video["vw"] > 0 and video["duration"] > 0, video
     assert video["w"] > 0 and video["h"] > 0, video
     assert shot.stat().st_size > 10_000
+
+
+def test_a_backward_walk_shows_its_clip_played_backward(robot):
+    """The report's human row of a backward run (``learn --backward``) is the clip's gait
+    cycle in reverse: the same frames, the other way round, and it says so."""
+    import matplotlib.pyplot as plt
+
+    from imitwalk.evidence.media import human_strip
+    from imitwalk.mocap import default_clip, load_motion
+    from imitwalk.step.pipeline import gait_from_motion
+    from imitwalk.step.style import reversed_in_time
+
+    fwd = gait_from_motion(load_motion(default_clip()), robot)
+    back = replace(fwd, style=reversed_in_time(fwd.style))
+    titles = {}
+    for name, gait in (("fwd", fwd), ("back", back)):
+        fig, missing = human_strip(gait, 6)
+        assert missing is None and fig is not None
+        titles[name] = [a.get_title() for a in fig.axes]
+        titles[name + "_sup"] = fig.get_suptitle()
+        plt.close(fig)
+    assert "played backward" in titles["back_sup"] and "played backward" not in titles["fwd_sup"]
+    frames = {k: [int(t.split()[1]) for t in titles[k]] for k in ("fwd", "back")}  # "frame N"
+    assert frames["back"][0] == frames["fwd"][0] and frames["back"][1:] == frames["fwd"][:0:-1]

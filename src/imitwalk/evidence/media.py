@@ -151,7 +151,8 @@ def robot_strip(
 
 
 def human_strip(ref: Reference | StepGait, count: int) -> tuple[Figure | None, str | None]:
-    """Fig. 8's first row (or the reason it is missing)."""
+    """Fig. 8's first row (or the reason it is missing): one gait cycle of the clip, in
+    reverse for a backward walk (``learn --backward`` imitates the clip played backward)."""
     from imitwalk.errors import MocapError
     from imitwalk.mocap import load_motion
 
@@ -163,11 +164,15 @@ def human_strip(ref: Reference | StepGait, count: int) -> tuple[Figure | None, s
         a, b = (int(v) for v in ref.cycles[0])
     else:
         a, b = 0, motion.n_frames
-    frames = np.linspace(a, b, count, endpoint=False).astype(int)
+    style = getattr(ref, "style", None)
+    backward = style is not None and style.step_length < 0
+    ends = (b, a) if backward else (a, b)
+    frames = np.linspace(*ends, count, endpoint=False).astype(int)
     if motion.loop:  # cycles of a looping clip count frames of the clip repeated
         frames %= int(motion.meta.get("period_frames", motion.n_frames))
     frames = np.clip(frames, 0, motion.n_frames - 1)
-    label = f"human demonstration ({Path(ref.source).name}, one gait cycle)"
+    played = ", played backward" if backward else ""
+    label = f"human demonstration ({Path(ref.source).name}, one gait cycle{played})"
     return plots.skeleton_strip(motion, frames, label), None
 
 
