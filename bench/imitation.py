@@ -37,7 +37,7 @@ def measure(path: str, seconds: float) -> dict:
     human = st.human
     # the soles' stride is a distance and a backward walk's style (learn --backward) is
     # negative: the robot's is signed the way it walked
-    way = -1.0 if st.step_length < 0 else 1.0
+    way = -1.0 if st.backward else 1.0
     stride = None if timing.stride_m is None else way * timing.stride_m
     speed = None if stride is None else stride / timing.cycle_s
     out = {

@@ -73,7 +73,7 @@ def test_learn_backward_writes_a_backward_run_that_resumes_as_one(tmp_path, caps
     assert main(["learn", "--backward", "--out", str(out), "--json", *sets(TINY_STEP)]) == 0
     capsys.readouterr()
     first = StepGait.load(out / "style.json").style
-    assert first.step_length < 0
+    assert first.step_length < 0 and first.backward
     # its default controller (and the search's start) is the shipped backward gains
     default = json.loads((out / "gains.json").read_text())["default"]
     assert default == shipped_gains(backward=True).to_dict() != shipped_gains().to_dict()

@@ -113,7 +113,7 @@ def learn(args: argparse.Namespace) -> int:
     args.variant = _variant(args)
     if args.variant == "step":
         return _learn_step(args, robot)
-    if getattr(args, "backward", False):
+    if args.backward:
         from imitwalk.errors import ConfigError
 
         raise ConfigError(
@@ -262,7 +262,7 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
         args.resume,
         progress,
         recorded_robot(args),
-        backward=bool(getattr(args, "backward", False)),
+        backward=args.backward,
     )
     return _learned(summary, args, rd)
 

@@ -130,7 +130,7 @@ def _stepping_run(args: argparse.Namespace) -> tuple[RunDir, LoadedRun, Robot]:
         raise ConfigError(
             f"{rd.path} is a {lr.learner!r} run; navigate steers the stepping gait (learner: step)"
         )
-    if isinstance(lr.ref, StepGait) and lr.ref.style.step_length < 0:
+    if isinstance(lr.ref, StepGait) and lr.ref.style.backward:
         raise ConfigError(
             f"{rd.path} walks backward (learn --backward); navigate steers a forward walk"
         )

@@ -155,6 +155,7 @@ def human_strip(ref: Reference | StepGait, count: int) -> tuple[Figure | None, s
     reverse for a backward walk (``learn --backward`` imitates the clip played backward)."""
     from imitwalk.errors import MocapError
     from imitwalk.mocap import load_motion
+    from imitwalk.step.gait import StepGait
 
     try:
         motion = load_motion(ref.source)
@@ -164,8 +165,7 @@ def human_strip(ref: Reference | StepGait, count: int) -> tuple[Figure | None, s
         a, b = (int(v) for v in ref.cycles[0])
     else:
         a, b = 0, motion.n_frames
-    style = getattr(ref, "style", None)
-    backward = style is not None and style.step_length < 0
+    backward = isinstance(ref, StepGait) and ref.style.backward
     ends = (b, a) if backward else (a, b)
     frames = np.linspace(*ends, count, endpoint=False).astype(int)
     if motion.loop:  # cycles of a looping clip count frames of the clip repeated

@@ -49,7 +49,7 @@ class NominalWalk:
         hip = pelvis_z - geom.hip_z - geom.ankle  # the hips over the ankles [m]
         reach = geom.leg * 0.99
         far = 2 * np.sqrt(max(reach**2 - hip**2, 0.0))  # both legs reaching, hips midway
-        ahead, behind = (far, 0.5 * far) if style.step_length >= 0 else (0.5 * far, far)
+        ahead, behind = (0.5 * far, far) if style.backward else (far, 0.5 * far)
         length = abs(style.step_length)
         self.limits = StepLimits(
             forward=max(ahead, style.step_length),
@@ -75,7 +75,7 @@ class NominalWalk:
         if k not in self._gaits:
             st, g = self.style, self.gains
             # the ZMP rolls the way the walk goes: heel to toe, or toe to heel backward
-            roll = g.zmp_roll * self.half[0] * (1.0 if st.step_length >= 0 else -1.0)
+            roll = g.zmp_roll * self.half[0] * (-1.0 if st.backward else 1.0)
             self._gaits[k] = NominalGait(
                 step=stride * stride_at(k[0], st.step_length),
                 width=st.step_width,

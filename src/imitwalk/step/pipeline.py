@@ -111,7 +111,7 @@ def learn_clip(
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
         gait = StepGait.load(rd.file("style.json"))
     # the search starts from the shipped gains of the walk's direction
-    start = shipped_gains(backward=gait.style.step_length < 0)
+    start = shipped_gains(backward=gait.style.backward)
     if not resume:
         if rd.exists("config.json") or rd.exists("checkpoint.json"):
             raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")

@@ -96,6 +96,11 @@ class GaitStyle:
         return self.hip_height + self.geometry.hip_z
 
     @property
+    def backward(self) -> bool:
+        """Whether the walk goes backward (a negative step, :func:`reversed_in_time`)."""
+        return self.step_length < 0
+
+    @property
     def single_support(self) -> float:
         """Single-support time of a step [s]."""
         return self.step_time - self.double_support
@@ -107,7 +112,13 @@ class GaitStyle:
 
     def upper_at(self, phase: float) -> dict[str, float]:
         """The arms' and waist's offsets [rad] at gait phase ``phase`` (wrapped to [0, 1))."""
-        return {role: _cyclic_at(prof, phase) for role, prof in self.upper.items()}
+        out = {}
+        for role, prof in self.upper.items():
+            x = (phase % 1.0) * len(prof)
+            i = int(x)
+            f = x - i
+            out[role] = float((1.0 - f) * prof[i % len(prof)] + f * prof[(i + 1) % len(prof)])
+        return out
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary (arrays as lists)."""
@@ -228,10 +239,8 @@ def reversed_in_time(style: GaitStyle) -> GaitStyle:
     off = 0.5 + style.double_support / (2.0 * style.step_time)  # ψ of the left lift-off
     upper = {}
     for role, prof in style.upper.items():
-        prof = np.asarray(prof, dtype=float)
-        p = len(prof)
-        psi = (off - np.arange(p) / p) % 1.0  # where ψ' = k / p reads the forward profile
-        upper[role] = np.array([_cyclic_at(prof, x) for x in psi])
+        grid = np.arange(len(prof)) / len(prof)  # the ψ of each sample
+        upper[role] = np.interp(off - grid, grid, prof, period=1.0)  # u(ψ_off − ψ')
     return replace(
         style,
         step_length=-style.step_length,
@@ -240,12 +249,3 @@ def reversed_in_time(style: GaitStyle) -> GaitStyle:
         upper=upper,
         turn=-style.turn,
     )
-
-
-def _cyclic_at(prof: np.ndarray, phase: float) -> float:
-    """The cyclic profile ``prof`` ``(P,)`` (sampled at ψ = k / P) at ``phase``, linearly
-    interpolated."""
-    x = (phase % 1.0) * len(prof)
-    i = int(x)
-    f = x - i
-    return float((1.0 - f) * prof[i % len(prof)] + f * prof[(i + 1) % len(prof)])
