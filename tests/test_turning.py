@@ -103,4 +103,4 @@ def test_learn_says_how_a_turning_clip_turns(tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["learn", str(_walker("turn_right0")), "--out", str(out), *sets(TINY_STEP)]) == 0
     err = capsys.readouterr().err
-    assert "turning -38.7 deg per cycle (the clip's -99.3 deg, beyond the gait's limit)" in err
+    assert "turning -45.0 deg per cycle (the clip's -99.3 deg, beyond the gait's limit)" in err

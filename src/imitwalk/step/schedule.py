@@ -26,10 +26,13 @@ __all__ = [
 ]
 
 #: A step turns the foot by at most this much from the stance foot's heading [rad],
-#: picked by trials on training robots (``eval`` seeds 100-119; pybullet's walker clips
-#: ``turn_left1`` and ``turn_right1``, which turn 55.6° and 53.0° a loop, each held at
-#: :data:`~imitwalk.step.style.MAX_TURN`): 1 of 40 fell at 0.45 rad, 9 of 40 at 0.52.
-MAX_STEP_YAW = 0.45
+#: picked by trials on training robots (``eval`` seeds 100-119, 30 s; pybullet's walker
+#: clips ``turn_left1`` and ``turn_right1``, which turn 55.6° and 53.0° a loop, each held
+#: at :data:`~imitwalk.step.style.MAX_TURN`): none of 40 fell at 0.45, 0.5 or 0.55 rad,
+#: and the slowest robot turned 35.7°, 41.3° and 44.4° a cycle of the 45° asked (the
+#: heading's feedback needs room above the turn fed forward). The least of the two that
+#: kept up.
+MAX_STEP_YAW = 0.5
 #: Steps over which the stride grows from nothing to the style's.
 START_STEPS = 3
 #: Settling from the standing posture to the walking one, and shifting the weight

@@ -22,7 +22,6 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.params import LegGeometry
-from imitwalk.step.schedule import MAX_STEP_YAW
 
 if TYPE_CHECKING:  # the template is read from mocap (SciPy); a style alone needs neither
     from imitwalk.retarget.template import GaitTemplate
@@ -41,12 +40,14 @@ __all__ = [
 #: The stance knee keeps at least this flexion at the nominal step [deg]: a position-
 #: servoed knee near straight cannot lower or shift the hip, so nothing can balance.
 KNEE_MIN_DEG = 20.0
-#: A turning gait turns at most this much per cycle [rad] (38.7°): three quarters of two
-#: steps' turn (:data:`~imitwalk.step.schedule.MAX_STEP_YAW`), the rest left to the
-#: heading's feedback. With all of two steps' turn fed forward (the steps' limit then
-#: 0.35 rad; ``walker_turn_right0``, which turns 99° a loop), 10 eval robots turned 25-35°
-#: a cycle instead of 40° and 2 fell; with three quarters they turned what was asked.
-MAX_TURN = 1.5 * MAX_STEP_YAW
+#: A turning gait turns at most this much per cycle [rad] (45°, 0.785 of two steps' turn,
+#: :data:`~imitwalk.step.schedule.MAX_STEP_YAW`; the rest is left to the heading's
+#: feedback). Picked by trials on training robots (``eval`` seeds 100-119, 30 s,
+#: ``walker_turn_left1`` and ``turn_right1``): none of 40 fell at 45°, 5 of 40 at 48°
+#: and 3 of 40 at 51°. With all of two steps' turn fed forward (0.35 rad a step then;
+#: ``walker_turn_right0``, 99° a loop) 10 eval robots turned 25-35° a cycle of 40° and
+#: 2 fell.
+MAX_TURN = np.pi / 4
 #: The least swing clearance, a fraction of the leg (a tenth, as the joint-space gait's):
 #: a clip's foot may skim the floor (CMU 07_04's lifts 1.4 cm on hoap2's scale), and at
 #: 0.08 of the leg hoap2's swing foot scuffed the floor mid-swing on 07_04.
