@@ -86,11 +86,27 @@ def test_evaluate_explains_the_falls_when_asked(run, capsys):
             ["--push-recovery", "--controllers", "learned,nosuch"],
             "unknown controller 'nosuch'; valid: feedback, fixed, learned, open_loop",
         ),
-        (["--seeds", "0"], "--seeds 0 --seconds 30: expected >= 1 robots and > 0 s"),
+        (["--seeds", "0"], "--seeds 0: expected >= 1"),
+        (["--seconds", "inf"], "--seconds inf: expected a finite number of seconds >= 0.1"),
+        (["--seconds", "0.001"], "--seconds 0.001: expected a finite number of seconds >= 0.1"),
+        (["--scale", "nan"], "--scale nan: expected a stride scale in (0, 1.5]"),
+        (["--scale", "-1"], "--scale -1: expected a stride scale in (0, 1.5]"),
+        (["--workers", "0"], "--workers 0: expected >= 1 processes (default: one per core)"),
+        (
+            ["--joint-map", "nosuch.json"],
+            "--joint-map nosuch.json needs --robot (the MJCF it maps); without both, the "
+            "robot the run records is used",
+        ),
+        (
+            ["--push-recovery", "--explain-falls"],
+            "--push-recovery and --explain-falls: push recovery kicks the nominal robot (no "
+            "protocol's falls to explain); give one of them",
+        ),
     ],
 )
 def test_evaluate_refuses_in_one_line(run, capsys, args, expect):
-    assert main(["evaluate", str(run), "--workers", "1", *args]) == 2
+    workers = [] if "--workers" in args else ["--workers", "1"]
+    assert main(["evaluate", str(run), *workers, *args]) == 2
     assert _one_line_error(capsys) == f"error: {expect}"
     assert not list(run.glob("protocol_*.json")) and not RunDir(run).exists("push_recovery.json")
 

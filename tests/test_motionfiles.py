@@ -267,3 +267,30 @@ def test_convert_writes_both_formats_and_refuses_bad_input(tiny_reference, tmp_p
         err = capsys.readouterr().err.strip().splitlines()
         assert err[-1].startswith("error: ") and word in err[-1], (argv, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.pkl", "b.npz"]
+
+
+@pytest.mark.parametrize("kind", ["reference", "locomujoco"])
+@pytest.mark.parametrize("keep", [0, 300, -200])
+def test_convert_refuses_a_damaged_npz_in_one_line_as_playback_does(
+    walk, robot, tiny_reference, tmp_path, capsys, kind, keep
+):
+    """A truncated (first 300 bytes, or all but the last 200) or empty ``.npz``: exit 2 and
+    one line from the checked reader ``playback`` uses (the same line for a truncated
+    file), no zip traceback."""
+    from imitwalk.cli import main
+    from imitwalk.retarget.motionfiles import write_locomujoco
+
+    _, ref_path = tiny_reference
+    good = ref_path if kind == "reference" else write_locomujoco(walk, robot, tmp_path / "t.npz")
+    raw = good.read_bytes()
+    bad = tmp_path / "truncated.npz"
+    bad.write_bytes(raw[:keep])
+    out = tmp_path / "x.pkl"
+    assert main(["convert", str(bad), "--to", "gmr", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "Traceback" not in "\n".join(err) and err[-1].startswith("error: "), err
+    assert ("empty" if keep == 0 else "truncated or corrupt") in err[-1], err
+    assert not out.exists()
+    assert main(["playback", str(bad)]) == 2
+    same = capsys.readouterr().err.strip().splitlines()[-1] == err[-1]
+    assert same or keep == 0  # an empty file: each names what it expected

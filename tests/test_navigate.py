@@ -67,6 +67,8 @@ def test_commands_and_courses_refuse_bad_values_in_one_line():
         parse_waypoints(["1;2"])
     with pytest.raises(ConfigError, match="no waypoints"):
         parse_waypoints([])
+    with pytest.raises(ConfigError, match=r"waypoint 1 '1e300,0'.*within ±1000 m"):
+        parse_waypoints(["1e300,0"])
     with pytest.raises(ConfigError, match=r"waypoint 1 is \[inf, 0.0\]"):
         Course(np.array([[np.inf, 0.0]]))
     with pytest.raises(ConfigError, match="reach"):
@@ -166,6 +168,15 @@ def test_bad_navigate_commands_exit_2_with_one_line(step_run, tick_run, tmp_path
         ([*base, "--fix-noise", "0.1"], "--fix-rate"),
         ([*base, "--fix-rate", "-1"], "rate"),
         ([*base, "--seeds", "0"], "--seeds 0"),
+        ([*base, "--waypoints", "1e300,0"], "within ±1000 m"),
+        ([*base, "--seconds", "inf"], "--seconds inf: expected a finite number"),
+        ([*base, "--seconds", "0.002"], "--seconds 0.002"),
+        ([*base, "--workers", "0"], "--workers 0"),
+        ([*base, "--joint-map", "x.json"], "--joint-map x.json needs --robot"),
+        (
+            ["navigate", str(step_run), "--no-video", "--out", str(tmp_path / "no" / "n")],
+            "does not exist",
+        ),
         (["navigate", str(tick_run), "--no-video"], "learner: step"),
         (["navigate", str(back), "--no-video"], "walks backward"),
         (["navigate", str(tmp_path / "none")], "not found"),

@@ -160,6 +160,11 @@ def test_learn_and_evaluate_a_stepping_run_through_the_cli(tmp_path, capsys):
     assert main(argv) == 0
     ev = json.loads(capsys.readouterr().out)
     assert set(ev["controllers"]) == {"learned", "default"}
+    # resumed, it keeps its learner and its direction: other ones are refused in one line
+    for flags, word in [(["--backward"], "walks forward"), (["--variant", "extended"], "'step'")]:
+        assert main(["learn", "--out", str(out), "--resume", *flags, *sets(TINY_STEP)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("error: ") and word in err and "\n" not in err
     # a damaged checkpoint is refused on --resume in one line, before any walk
     (out / "cma.pkl").write_bytes((out / "cma.pkl").read_bytes()[:40])
     assert main(["learn", "--out", str(out), "--resume", *sets(TINY_STEP)]) == 2

@@ -104,3 +104,12 @@ def test_learn_says_how_a_turning_clip_turns(tmp_path, capsys):
     assert main(["learn", str(_walker("turn_right0")), "--out", str(out), *sets(TINY_STEP)]) == 0
     err = capsys.readouterr().err
     assert "turning -45.0 deg per cycle (the clip's -99.3 deg, beyond the gait's limit)" in err
+
+
+def test_a_turning_clip_played_backward_is_said_to_turn_the_other_way(left):
+    from imitwalk.step.pipeline import _turning
+    from imitwalk.step.style import reversed_in_time
+
+    said = _turning(reversed_in_time(left.style))
+    assert said == ", turning -29.8 deg per cycle (the clip's +29.8 deg played backward)"
+    assert _turning(left.style) == ", turning +29.8 deg per cycle"

@@ -67,9 +67,21 @@ def search_report(gen: int, total: int, score: float, params: dict) -> None:
 
 
 def playback(args: argparse.Namespace) -> int:
+    from imitwalk.cli.arg_checks import (
+        check_count,
+        check_joint_map_alone,
+        check_scale,
+        check_seconds,
+        check_workers,
+    )
     from imitwalk.retarget import Reference
     from imitwalk.retarget.playback import play_reference, summary
 
+    check_scale(args.scale)
+    check_seconds(args.seconds)
+    check_count(args.models, "--models")
+    check_workers(args.workers)
+    check_joint_map_alone(args)
     ref = Reference.load(args.reference)
     if args.robot is None:
         args.robot = ref.provenance.robot or ref.robot
@@ -204,17 +216,27 @@ def _variant(args: argparse.Namespace) -> str:
     stepping gait."""
     import json
 
-    if args.variant:
-        return str(args.variant)
-    if args.reference:
-        return "extended"
+    from imitwalk.errors import ConfigError
+
     config = Path(args.out) / "config.json"
+    learner = None
     if args.resume and config.is_file():
         try:
             learner = json.loads(config.read_text()).get("learner")
         except (ValueError, AttributeError, OSError):
             learner = None
-        return {"tick": "extended", "faithful": "faithful"}.get(str(learner), "step")
+    resumed = {"tick": "extended", "faithful": "faithful", "step": "step"}.get(str(learner))
+    if args.variant:
+        if learner is not None and resumed != args.variant:
+            raise ConfigError(
+                f"--variant {args.variant}: {config.parent} is a {learner!r} run "
+                f"({resumed or 'not learned by learn'}); resume it without --variant"
+            )
+        return str(args.variant)
+    if args.reference:
+        return "extended"
+    if learner is not None:
+        return resumed or "step"
     return "step"
 
 
@@ -225,7 +247,7 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
     from imitwalk.runs import RunDir
     from imitwalk.sim.protocol import load_protocol
     from imitwalk.step.learn import StepLearnConfig
-    from imitwalk.step.pipeline import learn
+    from imitwalk.step.pipeline import learn, resumed_gait
 
     if args.reference:
         raise ConfigError(
@@ -246,6 +268,7 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
     rd.check_writable()
     motion = None
     if args.resume:
+        resumed_gait(rd.path, args.backward)  # its direction is its own: refused at once
         progress(f"learn: resuming {rd.path}")
     else:
         motion = _motion(args, robot)

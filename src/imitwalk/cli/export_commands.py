@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from imitwalk.cli.arg_checks import check_scale
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
 
@@ -12,15 +13,14 @@ __all__ = ["add_parser", "export"]
 
 def export(args: argparse.Namespace) -> int:
     from imitwalk import readback
-    from imitwalk.errors import ConfigError
     from imitwalk.judge.export import export_run
     from imitwalk.runs import RunDir
     from imitwalk.runtime.bundle import MANIFEST
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
-    if args.scale is not None and not 0.0 < args.scale <= 1.5:
-        raise ConfigError(f"--scale {args.scale:g}: expected a stride scale in (0, 1.5]")
+    check_scale(args.scale)
+    RunDir(args.out).check_writable("--out")  # before anything is built
     args.robot, args.joint_map = run_robot(rd, cfg)
     robot = robot_from(args)
     out = export_run(rd.path, robot, args.out, args.controller, args.scale)

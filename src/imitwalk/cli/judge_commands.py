@@ -6,6 +6,13 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
+from imitwalk.cli.arg_checks import (
+    check_count,
+    check_joint_map_alone,
+    check_scale,
+    check_seconds,
+    check_workers,
+)
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
 
@@ -23,6 +30,14 @@ def evaluate(args: argparse.Namespace) -> int:
     from imitwalk.runs import RunDir
     from imitwalk.sim.protocol import load_protocol
 
+    check_scale(args.scale)
+    check_workers(args.workers)
+    check_joint_map_alone(args)
+    if args.push_recovery and args.explain_falls:
+        raise ConfigError(
+            "--push-recovery and --explain-falls: push recovery kicks the nominal robot "
+            "(no protocol's falls to explain); give one of them"
+        )
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     rd.check_writable("RUN_DIR")  # the verdict is written there
@@ -32,10 +47,8 @@ def evaluate(args: argparse.Namespace) -> int:
     if args.push_recovery:
         return _push_recovery(args, rd, robot)
     protocol = load_protocol(args.protocol)
-    if args.seeds < 1 or not args.seconds > 0:
-        raise ConfigError(
-            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
-        )
+    check_count(args.seeds, "--seeds")
+    check_seconds(args.seconds)
     chosen = tuple(args.controllers.split(",")) if args.controllers else None
     progress(
         f"evaluate: protocol {protocol.name} v{protocol.version} on {protocol.engine}, "
@@ -89,6 +102,7 @@ def report(args: argparse.Namespace) -> int:
     from imitwalk.evidence.report import write_report
     from imitwalk.runs import RunDir
 
+    check_seconds(args.seconds)
     rd = RunDir(args.run_dir)
     rd.read_summary()  # a clear error if this is not a finished run
     rd.check_writable("RUN_DIR")  # report.html is written there

@@ -15,14 +15,17 @@ TARGETS = {"gmr": ".pkl", "locomujoco": ".npz"}
 
 
 def _is_reference(path: Path) -> bool:
-    """An imitwalk reference ``.npz`` (not a LocoMuJoCo trajectory, which has ``qpos``)."""
-    import zipfile
+    """An imitwalk reference ``.npz`` (not a LocoMuJoCo trajectory, which has ``qpos``).
 
-    try:
-        with zipfile.ZipFile(path) as z:
-            return "qpos.npy" not in z.namelist()
-    except (OSError, zipfile.BadZipFile):
-        return False
+    The archive is read by the checked reader that ``playback`` uses
+    (:func:`~imitwalk.readback.read_npz`), so a missing, empty, truncated or corrupt
+    ``.npz`` of either kind is one line (MocapError), never a zip or zlib traceback.
+    """
+    from imitwalk.errors import MocapError
+    from imitwalk.readback import read_npz
+
+    arrays = read_npz(path, "a reference .npz (from retarget) or a LocoMuJoCo .npz", MocapError)
+    return "qpos" not in arrays
 
 
 def convert(args: argparse.Namespace) -> int:

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from imitwalk.cli.arg_checks import check_count, check_joint_map_alone, check_seconds, check_workers
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.robot_args import robot_from, run_robot
 
@@ -72,16 +73,15 @@ def _video(job: NavJob, result: NavResult, path: Path) -> Path:
 
 
 def navigate(args: argparse.Namespace) -> int:
-    from imitwalk.errors import ConfigError
     from imitwalk.fileio import atomic_write
     from imitwalk.navigate.trial import run_nav_job
     from imitwalk.parallel import run_parallel
 
     course = _course(args)
-    if args.seeds < 1 or not args.seconds > 0:
-        raise ConfigError(
-            f"--seeds {args.seeds} --seconds {args.seconds:g}: expected >= 1 robots and > 0 s"
-        )
+    check_count(args.seeds, "--seeds")
+    check_seconds(args.seconds)
+    check_workers(args.workers)
+    check_joint_map_alone(args)
     fix = _fix(args)
     rd, lr, robot = _stepping_run(args)
     out = _out_dir(args, rd)
@@ -144,6 +144,9 @@ def _out_dir(args: argparse.Namespace, rd: RunDir) -> Path:
     out = Path(args.out) if args.out else Path(rd.path) / "navigate"
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out}: exists and is not a folder")
+    from imitwalk.runs import RunDir
+
+    RunDir(out).check_writable("--out")  # before the walks, not after them
     return out
 
 

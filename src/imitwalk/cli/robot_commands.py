@@ -56,8 +56,10 @@ def robot_info(args: argparse.Namespace) -> int:
 def robot_stand(args: argparse.Namespace) -> int:
     """Hold the standing posture ``--seconds``; exit 2 with the stand check's one line if
     the robot does not stand (:mod:`imitwalk.sim.standing`)."""
+    from imitwalk.cli.arg_checks import check_seconds
     from imitwalk.sim.standing import require_standing
 
+    check_seconds(args.seconds)
     res = require_standing(robot_from(args), robot_label(args), seconds=args.seconds)
     emit(res.to_dict(), args.json, finite=True)
     return 0

@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from imitwalk.sim.types import Observation
     from imitwalk.step.gait import StepGait
 
-__all__ = ["OPEN_LOOP", "LoadedRun", "load_run"]
+__all__ = ["LEARNERS", "OPEN_LOOP", "LoadedRun", "load_run"]
 
 #: The controller every run can build: its reference played as it is.
 OPEN_LOOP = "open_loop"
@@ -202,25 +202,70 @@ class LoadedRun:
         return self.gait.policy(scale)
 
 
+#: The learners whose runs :func:`load_run` reads, as ``config.json`` names them.
+LEARNERS = ("step", "rl", "tick", "faithful")
+
+
+def _gains(rd: RunDir, names: tuple[str, ...], what: str) -> dict:
+    """The gains ``names`` of the run's ``gains.json`` (``what``: the run's kind, as a
+    message says it), each a :class:`~imitwalk.step.gains.StepGains`.
+
+    Raises:
+        RunError: one line naming the file and the entry missing or invalid, and the
+            entries such a run's gains.json holds.
+    """
+    from imitwalk.step.gains import StepGains
+
+    path, saved = rd.file("gains.json"), rd.read_json("gains.json")
+    holds = " and ".join(repr(n) for n in names)
+    missing = [n for n in names if n not in saved]
+    if missing:
+        raise RunError(
+            f"{path} lacks {', '.join(repr(n) for n in missing)}: {what}'s gains.json holds "
+            f"{holds} (each a mapping of gain names to numbers)"
+        )
+    out = {}
+    for name in names:
+        try:
+            out[name] = StepGains.from_dict(saved[name])
+        except ConfigError as exc:
+            raise RunError(f"{path}: {name!r}: {exc}") from None
+    return out
+
+
 def load_run(run_dir: str | Path) -> LoadedRun:
     """Read a finished run folder (a one-line :class:`~imitwalk.errors.RunError` if it is
-    not one)."""
+    not one).
+
+    Its ``config.json`` names the learner (:data:`LEARNERS`); a run without one was
+    written before learners were named and is read as ``faithful``'s, as it was then.
+
+    Raises:
+        RunError: a file is missing or invalid (which, and why), or the learner is not
+            one of :data:`LEARNERS`.
+    """
     rd = RunDir(run_dir)
     config, metrics = rd.read_json("config.json"), rd.read_summary()
     if not isinstance(config, dict):
         raise RunError(f"{rd.file('config.json')} is not a run's settings (not a JSON object)")
-    engine = str(config.get("learn", {}).get("engine", "mujoco"))
-    if config.get("learner") == "rl":
+    learner = config.get("learner", "faithful")
+    if not isinstance(learner, str) or learner not in LEARNERS:
+        refused = unknown_name("learner", learner, LEARNERS, RunError)
+        raise RunError(f"{rd.file('config.json')}: {refused}")
+    learn = config.get("learn", {})
+    if not isinstance(learn, dict):
+        raise RunError(
+            f"{rd.file('config.json')}: learn must be an object of the learning settings "
+            f"(got a JSON {type(learn).__name__})"
+        )
+    engine = str(learn.get("engine", "mujoco"))
+    if learner == "rl":
         from imitwalk.rl.actor import ActorSpec
         from imitwalk.rl.network import MLP
-        from imitwalk.step.gains import StepGains
         from imitwalk.step.gait import StepGait
 
         gait = StepGait.load(rd.file("style.json"))
-        try:
-            default = StepGains.from_dict(rd.read_json("gains.json")["default"])
-        except (KeyError, TypeError, ConfigError) as exc:
-            raise RunError(f"{rd.file('gains.json')} is not a PPO run's gains: {exc}") from None
+        default = _gains(rd, ("default",), "a PPO run")["default"]
         actor = (ActorSpec.load(rd.file("actor.json")), MLP.load(rd.file("policy.npz")))
         return LoadedRun(
             str(rd.path),
@@ -232,18 +277,11 @@ def load_run(run_dir: str | Path) -> LoadedRun:
             step_gains={"default": default},
             actor=actor,
         )
-    if config.get("learner") == "step":
-        from imitwalk.step.gains import StepGains
+    if learner == "step":
         from imitwalk.step.gait import StepGait
 
         gait = StepGait.load(rd.file("style.json"))
-        saved = rd.read_json("gains.json")
-        try:
-            gains = {name: StepGains.from_dict(saved[name]) for name in ("learned", "default")}
-        except (KeyError, TypeError, ConfigError) as exc:
-            raise RunError(
-                f"{rd.file('gains.json')} is not a stepping run's gains: {exc}"
-            ) from None
+        gains = _gains(rd, ("learned", "default"), "a stepping run")
         return LoadedRun(
             str(rd.path),
             "step",
@@ -253,7 +291,7 @@ def load_run(run_dir: str | Path) -> LoadedRun:
             metrics,
             step_gains=gains,
         )
-    if config.get("learner") == "tick":
+    if learner == "tick":
         from imitwalk.balance.tickstore import load_laws
 
         ref = Reference.load(rd.file("reference.npz"))

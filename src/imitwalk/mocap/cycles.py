@@ -14,6 +14,7 @@ fallback: cycles then run from one maximum hip flexion to the next.
 
 from __future__ import annotations
 
+import math
 from itertools import pairwise
 
 import numpy as np
@@ -72,14 +73,19 @@ def _relative_ap(motion: Motion, name: str, fwd: np.ndarray) -> np.ndarray:
 
 
 def _clean_runs(mask: np.ndarray, min_len: int) -> np.ndarray:
-    """Flip runs (of either value) shorter than ``min_len`` frames, shortest first."""
-    mask = mask.copy()
+    """Merge inner runs (of either value) shorter than ``min_len`` frames into their
+    neighbours, shortest first.
+
+    Only a run with a neighbour on both sides is flipped: flipping it joins it with both,
+    so each pass removes two runs and the loop ends after at most ``len(mask) // 2``
+    passes. The first and last runs (and a mask of one run, or an empty one) are kept.
+    """
+    mask = np.array(mask, dtype=bool)  # a copy
     while True:
         edges = np.flatnonzero(np.diff(mask.astype(np.int8))) + 1
         bounds = np.concatenate([[0], edges, [len(mask)]])
         lengths = np.diff(bounds)
-        inner = [i for i in range(len(lengths)) if 0 < i < len(lengths) - 1 or len(lengths) == 1]
-        short = [i for i in inner if lengths[i] < min_len]
+        short = [i for i in range(1, len(lengths) - 1) if lengths[i] < min_len]
         if not short:
             return mask
         i = min(short, key=lambda j: lengths[j])
@@ -189,6 +195,26 @@ def _cycles_from_periodicity(motion: Motion, foot: str) -> list[tuple[int, int]]
     return [(int(a), int(b)) for a, b in pairwise(peaks) if 0.7 * period <= b - a <= 1.3 * period]
 
 
+def _min_frames(fps: float) -> int:
+    """Fewest frames that can hold one gait cycle at ``fps`` [Hz]: ``MIN_PERIOD_S`` (0.4 s),
+    and at least 8."""
+    return max(8, math.ceil(MIN_PERIOD_S * fps - 1e-9))
+
+
+def _check_length(motion: Motion) -> None:
+    """MocapError (one line: frames, seconds, the minimum) if ``motion`` is shorter than
+    one gait cycle can be."""
+    n, need = motion.n_frames, _min_frames(motion.fps)
+    if n >= need:
+        return
+    dropped = " (after dropping the T-pose frame 0)" if motion.meta.get("skipped_frames") else ""
+    raise MocapError(
+        f"no walking cycle found in {motion.source}: only {n} frame{'' if n == 1 else 's'}"
+        f"{dropped} = {n / motion.fps:.3g} s at {motion.fps:g} fps, need >= {need} frames "
+        f"(one gait cycle lasts >= {MIN_PERIOD_S:g} s)"
+    )
+
+
 def find_cycles(motion: Motion, foot: str = "l") -> list[tuple[int, int]]:
     """Whole gait cycles of ``foot``: ``(start, end)`` frame pairs, end exclusive.
 
@@ -198,12 +224,12 @@ def find_cycles(motion: Motion, foot: str = "l") -> list[tuple[int, int]]:
     per loop is one cycle ``[(0, period_frames)]``. Falls back to hip periodicity.
 
     Raises:
-        MocapError: ``"no walking cycle found in ..."`` if there is none.
+        MocapError: ``"no walking cycle found in ..."`` if there is none, or if the clip
+            is shorter than one cycle can be (0.4 s and 8 frames; the message says so).
     """
     _check_foot(foot)
     src = motion.source
-    if motion.duration < MIN_PERIOD_S or motion.n_frames < 8:
-        raise MocapError(f"no walking cycle found in {src}: only {motion.n_frames} frames")
+    _check_length(motion)
     fwd = heading(motion)
     reach = _leg_length(motion) * 0.1
     contacts = foot_contacts(motion)

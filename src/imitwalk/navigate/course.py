@@ -13,8 +13,11 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 
-__all__ = ["DEFAULT_COURSE", "REACH_M", "Course", "parse_waypoints"]
+__all__ = ["DEFAULT_COURSE", "MAX_WAYPOINT_M", "REACH_M", "Course", "parse_waypoints"]
 
+#: A waypoint lies at most this far from the start along x or y [m] (a walk of 90 s
+#: covers a few metres; a larger number is a typing error, and its square overflows).
+MAX_WAYPOINT_M = 1000.0
 #: A waypoint is reached when the robot's centre of mass passes within this of it [m].
 REACH_M = 0.25
 #: The course ``imitwalk navigate`` walks by default: five waypoints 0.6 to 0.8 m apart,
@@ -77,7 +80,10 @@ def parse_waypoints(items: Sequence[str]) -> np.ndarray:
             xy = [float(p) for p in parts]
         except ValueError:
             xy = []
-        if len(xy) != 2 or not all(np.isfinite(xy)):
-            raise ConfigError(f"waypoint {i} {s!r}: expected two finite numbers x,y [m]")
+        if len(xy) != 2 or not all(np.isfinite(xy)) or max(map(abs, xy)) > MAX_WAYPOINT_M:
+            raise ConfigError(
+                f"waypoint {i} {s!r}: expected two finite numbers x,y [m] within "
+                f"±{MAX_WAYPOINT_M:g} m of the start"
+            )
         out.append(xy)
     return np.asarray(out, dtype=float)

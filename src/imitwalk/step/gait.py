@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from imitwalk import readback
-from imitwalk.errors import RunError
+from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.sim.types import SimOptions
 from imitwalk.step.schedule import START_STEPS, nominal_distance, nominal_track, start_seconds
-from imitwalk.step.style import GaitStyle
+from imitwalk.step.style import GaitStyle, as_number, longest_step
 
 #: The format version ``style.json`` is written in (and the newest :meth:`StepGait.load`
 #: reads; a file without one reads as 1). 2: the style's ``stride_share`` (a format-1
@@ -49,6 +49,40 @@ class StepGait:
     source: str = ""
     cycles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
     provenance: Provenance = field(default_factory=Provenance)
+
+    def __post_init__(self) -> None:
+        self.check()
+
+    def check(self) -> None:
+        """Refuse a gait no walk can be made of (run on every gait made; its style checks
+        itself, :meth:`GaitStyle.check <imitwalk.step.style.GaitStyle.check>`).
+
+        ``dt`` must be finite, at least one physics step (``1 / SimOptions().physics_hz``,
+        1 ms) and shorter than the style's single support [s]; the style, at scale 1,
+        must step (``step_length`` nonzero: negative walks backward) and step shorter than
+        its legs reach (:func:`~imitwalk.step.style.longest_step`, as
+        :func:`~imitwalk.step.style.hip_height` requires of every style made from a clip).
+
+        Raises:
+            ConfigError: one line naming the field (``style.``: the style's), its valid
+                range and the value.
+        """
+        if not isinstance(self.style, GaitStyle):
+            raise ConfigError(f"style must be a GaitStyle (got {type(self.style).__name__})")
+        least, ss = 1.0 / SimOptions().physics_hz, self.style.single_support
+        as_number(self.dt, "dt")
+        if not (np.isfinite(self.dt) and least - 1e-12 <= self.dt < ss):
+            raise ConfigError(
+                f"dt must be a finite number, the control period [s], with {least:g} (a "
+                f"physics step) <= dt < {ss:g} (the style's single support) (got {self.dt:g})"
+            )
+        step, longest = self.style.step_length, longest_step(self.style.geometry)
+        if not 0.0 < abs(step) < longest:
+            raise ConfigError(
+                f"style.step_length must be a finite number with 0 < |step_length| < "
+                f"{longest:.4g} m (the legs' reach at scale 1; negative: backward) "
+                f"(got {step:g})"
+            )
 
     @property
     def period(self) -> float:
@@ -126,7 +160,14 @@ class StepGait:
 
     @classmethod
     def load(cls, path: str | Path) -> StepGait:
-        """Read a gait :meth:`save` wrote (a one-line :class:`RunError` if it cannot)."""
+        """Read a gait :meth:`save` wrote, checked (:meth:`check`,
+        :meth:`GaitStyle.check <imitwalk.step.style.GaitStyle.check>`).
+
+        Raises:
+            RunError: one line: the file cannot be read, is not a gait, or a field is out
+                of its range (``PATH: style.step_time must be a finite number > 0 [s]
+                (got nan)``).
+        """
         path = Path(path)
         try:
             d = json.loads(path.read_text())
@@ -134,13 +175,15 @@ class StepGait:
                 raise TypeError(f"a JSON {type(d).__name__}, not an object")
             readback.check_format(d, GAIT_FORMAT, str(path), RunError)
             return cls(
-                style=GaitStyle.from_dict(d["style"]),
+                style=GaitStyle.from_dict(d["style"], where="style."),
                 robot=str(d["robot"]),
-                dt=float(d["dt"]),
+                dt=as_number(d["dt"], "dt"),
                 source=str(d.get("source", "")),
                 cycles=np.asarray(d.get("cycles", []), dtype=int).reshape(-1, 2),
                 provenance=Provenance.from_settings(dict(d.get("settings") or {})),
             )
+        except ConfigError as exc:
+            raise RunError(f"{path}: {exc}") from None
         except FileNotFoundError:
             raise RunError(f"{path} not found: is {path.parent} a finished imitwalk run?") from None
         except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:

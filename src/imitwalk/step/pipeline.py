@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imitwalk.errors import MocapError, RunError
+from imitwalk.errors import ConfigError, MocapError, RunError
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.robots import Robot
 from imitwalk.runs import LearnSummary, RunDir, StepOutcome
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from imitwalk.sim.protocol import Protocol
     from imitwalk.step.style import GaitStyle
 
-__all__ = ["gait_from_motion", "learn", "learn_clip"]
+__all__ = ["gait_from_motion", "learn", "learn_clip", "resumed_gait"]
 
 
 def gait_from_motion(
@@ -144,6 +144,20 @@ def learn_clip(
     return summary
 
 
+def resumed_gait(out: str | Path, backward: bool = False) -> StepGait:
+    """The gait of the stepping run in ``out`` that is to be resumed; refused in one line
+    if ``backward`` is asked of a run that walks forward (a resumed run walks its own
+    style)."""
+    rd = RunDir(out)
+    gait = StepGait.load(rd.file("style.json"))
+    if backward and not gait.style.backward:
+        raise ConfigError(
+            f"--backward: {rd.path} walks forward, and a resumed run walks its own style; "
+            "learn a backward walk into a new folder"
+        )
+    return gait
+
+
 def learn(
     clip: Motion | str | Path | None = None,
     robot: Robot | str = "hoap2",
@@ -176,7 +190,7 @@ def learn(
     cfg = cfg or StepLearnConfig()
     protocol = load_protocol(cfg.protocol)
     if resume:
-        gait = StepGait.load(RunDir(out).file("style.json"))
+        gait = resumed_gait(out, backward)
     else:
         motion = clip if isinstance(clip, Motion) else load_clip(clip or default_clip(), robot)
         gait = gait_from_motion(motion, robot, named, backward=backward)
@@ -194,8 +208,14 @@ def _turning(style: GaitStyle) -> str:
     """How the style turns, for the learner's progress line ("" for a straight walk)."""
     if not style.turn:
         return ""
-    out = f", turning {np.degrees(style.turn):+.1f} deg per cycle"
+    deg = float(np.degrees(style.turn))
+    out = f", turning {deg:+.1f} deg per cycle"
     clip = style.human.get("turn_deg", 0.0)
-    if abs(np.degrees(style.turn) - clip) > 0.05:
+    held = abs(deg - (-clip if style.backward else clip)) > 0.05
+    if style.backward:  # played backward, the walk turns the other way
+        out += f" (the clip's {clip:+.1f} deg played backward" + (
+            ", held at the gait's limit)" if held else ")"
+        )
+    elif held:
         out += f" (the clip's {clip:+.1f} deg, beyond the gait's limit)"
     return out

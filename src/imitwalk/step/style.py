@@ -15,7 +15,8 @@ What the robot adds is its own: the step width (its hips' spacing), the pelvis h
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from collections.abc import Callable
+from dataclasses import MISSING, asdict, dataclass, fields, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +33,7 @@ __all__ = [
     "MAX_TURN",
     "GaitStyle",
     "hip_height",
+    "longest_step",
     "reversed_in_time",
     "style_from_template",
     "with_stride",
@@ -52,6 +54,16 @@ MAX_TURN = np.pi / 4
 #: a clip's foot may skim the floor (CMU 07_04's lifts 1.4 cm on hoap2's scale), and at
 #: 0.08 of the leg hoap2's swing foot scuffed the floor mid-swing on 07_04.
 LIFT_MIN = 0.1
+#: How far past :data:`MAX_TURN` a style's turn may read [rad] (rounding in a saved file).
+TURN_TOLERANCE = 1e-9
+
+#: The figures of the clip a style keeps (:attr:`GaitStyle.human`), each with its range.
+_HUMAN: dict[str, tuple[Callable[[float], bool], str]] = {
+    "period": (lambda v: v > 0, "> 0 [s]"),
+    "stride": (lambda v: True, "[m]"),
+    "leg": (lambda v: v > 0, "> 0 [m]"),
+    "speed": (lambda v: True, "[m/s]"),
+}
 
 
 @dataclass(frozen=True)
@@ -131,17 +143,244 @@ class GaitStyle:
         return d
 
     @classmethod
-    def from_dict(cls, d: dict) -> GaitStyle:
-        """Inverse of :meth:`to_dict` (a ``stride_share`` outside (0, 1]: ValueError)."""
-        d = dict(d)
-        share = float(d.get("stride_share", 1.0))
-        if not 0.0 < share <= 1.0:
-            raise ValueError(f"stride_share {share:g}: expected 0 < stride_share <= 1")
-        d["swing_x"] = np.asarray(d["swing_x"], dtype=float)
-        d["swing_z"] = np.asarray(d["swing_z"], dtype=float)
-        d["upper"] = {k: np.asarray(v, dtype=float) for k, v in d["upper"].items()}
-        d["geometry"] = LegGeometry(**d["geometry"])
-        return cls(**d)
+    def from_dict(cls, d: dict, where: str = "") -> GaitStyle:
+        """Inverse of :meth:`to_dict`. A file written before a field existed reads it at
+        its default (``turn`` 0, ``stride_share`` 1, the geometry's ``hip_ahead`` and
+        ``foot_width`` 0).
+
+        Args:
+            where: how a message names the style's fields (``"style."``: a gait file's).
+
+        Raises:
+            ConfigError: one line naming the field (``where`` + its name) that is
+                missing, unknown, not a number or out of its range (:meth:`check`).
+        """
+        try:
+            if not isinstance(d, dict):
+                raise ConfigError(f"the style must be an object (got {_shown(d)})")
+            unknown = sorted(set(d) - {f.name for f in fields(cls)})
+            if unknown:
+                valid = ", ".join(f.name for f in fields(cls))
+                raise ConfigError(f"{unknown[0]} is not a field of a style; valid: {valid}")
+            kw: dict = {}
+            for f in fields(cls):
+                if f.name in ("upper", "human", "geometry"):
+                    continue
+                if f.name in ("swing_x", "swing_z"):
+                    kw[f.name] = _array(_entry(d, f.name), f.name)
+                elif f.name in d or f.default is MISSING:
+                    kw[f.name] = as_number(_entry(d, f.name), f.name)
+            upper = _entry(d, "upper")
+            if not isinstance(upper, dict):
+                raise ConfigError(f"upper must be an object of role: profile (got {_shown(upper)})")
+            kw["upper"] = {k: _array(v, f"upper.{k}") for k, v in upper.items()}
+            human = _entry(d, "human")
+            if not isinstance(human, dict):
+                raise ConfigError(f"human must be an object (got {_shown(human)})")
+            kw["human"] = dict(human)
+            kw["geometry"] = _geometry(_entry(d, "geometry"))
+            return cls(**kw)
+        except ConfigError as exc:
+            raise ConfigError(f"{where}{exc}") from None
+
+    def __post_init__(self) -> None:
+        self.check()
+
+    def check(self) -> None:
+        """Refuse a style no walk can be made of (run on every style made).
+
+        Every number must be finite; ``step_time`` > 0 [s] and 0 < ``double_support`` <
+        ``step_time``; ``step_width`` > 0, 0 <= ``clearance`` < the leg, 0 <
+        ``hip_height`` <= the straight leg (``geometry.leg + geometry.ankle``) and the
+        pelvis above the soles [m]; ``|turn|`` <= :data:`MAX_TURN` [rad]; 0 <
+        ``stride_share`` <= 1; ``swing_x`` and ``swing_z`` of one length, at least 2
+        samples; the arms' and waist's profiles non-empty and of one length; the clip's
+        figures (:data:`_HUMAN`) finite, its period and leg > 0; the geometry's lengths
+        finite, the leg and sole > 0, the others' signs as measured. A step of any sign
+        (negative: backward, :attr:`backward`), zero included (a stride scaled to 0),
+        but finite; a turning style turns its clip's way forward and the other way
+        backward (:func:`reversed_in_time`).
+
+        Raises:
+            ConfigError: one line naming the field, its valid range and the value.
+        """
+        g = self.geometry
+        if not isinstance(g, LegGeometry):
+            raise ConfigError(f"geometry must be a robot's leg measures (got {_shown(g)})")
+        _check_geometry(g)
+        _need("step_time", self.step_time, lambda v: v > 0, "> 0 [s]")
+        st = self.step_time
+        _need(
+            "double_support",
+            self.double_support,
+            lambda v: 0 < v < st,
+            f"with 0 < double_support < step_time ({st:g} s) [s]",
+        )
+        _need("step_length", self.step_length, lambda v: True, "[m] (negative: backward)")
+        _need("step_width", self.step_width, lambda v: v > 0, "> 0 [m]")
+        _need(
+            "clearance",
+            self.clearance,
+            lambda v: 0 <= v < g.leg,
+            f"with 0 <= clearance < geometry.leg ({g.leg:g} m) [m]",
+        )
+        _need(
+            "hip_height",
+            self.hip_height,
+            lambda v: 0 < v <= g.hip_height,
+            f"with 0 < hip_height <= geometry.leg + geometry.ankle ({g.hip_height:g} m, "
+            "the straight leg) [m]",
+        )
+        if not self.pelvis_height > 0:
+            raise ConfigError(
+                f"hip_height + geometry.hip_z (the pelvis height) must be > 0 [m] "
+                f"(got {self.hip_height:g} + {g.hip_z:g})"
+            )
+        _need(
+            "turn",
+            self.turn,
+            lambda v: abs(v) <= MAX_TURN + TURN_TOLERANCE,
+            f"with |turn| <= MAX_TURN ({MAX_TURN:.4f} rad, {np.degrees(MAX_TURN):g} deg) "
+            "[rad per cycle]",
+        )
+        _need(
+            "stride_share",
+            self.stride_share,
+            lambda v: 0 < v <= 1,
+            "(a share of the clip's stride): expected 0 < stride_share <= 1",
+        )
+        for name in ("swing_x", "swing_z"):
+            _profile(name, getattr(self, name), least=2)
+        if len(self.swing_x) != len(self.swing_z):
+            raise ConfigError(
+                f"swing_x and swing_z must sample the swing alike (got {len(self.swing_x)} "
+                f"and {len(self.swing_z)} samples)"
+            )
+        if not isinstance(self.upper, dict):
+            got = _shown(self.upper)
+            raise ConfigError(f"upper must be a mapping of role: profile (got {got})")
+        sizes = {role: _profile(f"upper.{role}", prof) for role, prof in self.upper.items()}
+        if len(set(sizes.values())) > 1:
+            got = ", ".join(f"{k} {n}" for k, n in sizes.items())
+            raise ConfigError(f"upper's profiles must sample the gait alike (got {got} samples)")
+        self._check_human()
+
+    def _check_human(self) -> None:
+        """The clip's figures: :data:`_HUMAN` finite (period and leg > 0), ``turn_deg``
+        finite if given and, with the turn and the step, of a consistent sign."""
+        h = self.human
+        if not isinstance(h, dict):
+            raise ConfigError(f"human must be a mapping of the clip's figures (got {_shown(h)})")
+        for key, (ok, what) in _HUMAN.items():
+            if key not in h:
+                raise ConfigError(f"human.{key} is missing (the clip's {key} {what.split()[-1]})")
+            _need(f"human.{key}", h[key], ok, what)
+        _need("human.turn_deg", h.get("turn_deg", 0.0), lambda v: True, "[deg per cycle]")
+        clip = float(h.get("turn_deg", 0.0))
+        # forward, the style turns its clip's way; played backward, the other way
+        if self.turn and clip and self.step_length:
+            if np.sign(self.turn) != np.sign(clip) * np.sign(self.step_length):
+                way = "backward" if self.backward else "forward"
+                raise ConfigError(
+                    f"turn {self.turn:+g} rad and step_length {self.step_length:+g} m disagree "
+                    f"with the clip's turn (human.turn_deg {clip:+g}): a {way} style turns "
+                    + ("against its clip" if self.backward else "its clip's way")
+                )
+
+
+def _shown(v: object) -> str:
+    """``v`` as a message shows it: a number as ``%g``, anything else its short repr."""
+    if isinstance(v, float | int | np.floating | np.integer) and not isinstance(v, bool):
+        return f"{float(v):g}"
+    text = repr(v)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _entry(d: dict, key: str) -> object:
+    """``d[key]``, or a :class:`ConfigError` saying it is missing."""
+    if key not in d:
+        raise ConfigError(f"{key} is missing")
+    return d[key]
+
+
+def as_number(v: object, name: str) -> float:
+    """``v`` as a float (a :class:`ConfigError` naming ``name`` if it is not a number;
+    not-finite ones pass, for :func:`_need` to say their range)."""
+    if isinstance(v, bool) or not isinstance(v, int | float | np.floating | np.integer):
+        raise ConfigError(f"{name} must be a number (got {_shown(v)})")
+    return float(v)
+
+
+def _array(v: object, name: str) -> np.ndarray:
+    """``v`` as a float array (a :class:`ConfigError` naming ``name`` if it is not one)."""
+    try:
+        return np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be a list of numbers (got {_shown(v)})") from None
+
+
+def _need(name: str, v: object, ok: Callable[[float], bool], what: str) -> None:
+    """Refuse ``v`` unless it is a finite number for which ``ok`` holds (``what``: its
+    range and unit, as the message says it)."""
+    x = as_number(v, name)
+    if not (np.isfinite(x) and ok(x)):
+        raise ConfigError(f"{name} must be a finite number {what} (got {_shown(x)})")
+
+
+def _profile(name: str, prof: object, least: int = 1) -> int:
+    """Refuse a profile that is not a 1-D array of at least ``least`` finite numbers; its
+    length."""
+    a = np.asarray(prof)
+    if a.ndim != 1 or a.dtype.kind not in "fiu" or len(a) < least or not np.isfinite(a).all():
+        shape = f"{len(a)} samples" if a.ndim == 1 else f"shape {a.shape}"
+        numbers = a.ndim == 1 and a.dtype.kind in "fiu"
+        bad = " with a value that is not finite" if numbers and not np.isfinite(a).all() else ""
+        need = "a non-empty list of" if least == 1 else f"a list of at least {least}"
+        raise ConfigError(f"{name} must be {need} finite numbers (got {shape}{bad})")
+    return len(a)
+
+
+#: The robot's leg measures a style keeps (:class:`LegGeometry`), each with its range.
+_GEOMETRY: dict[str, tuple[Callable[[float], bool], str]] = {
+    "hip_y": (lambda v: v >= 0, ">= 0 [m]"),
+    "hip_z": (lambda v: True, "[m]"),
+    "leg": (lambda v: v > 0, "> 0 [m]"),
+    "ankle": (lambda v: v >= 0, ">= 0 [m]"),
+    "sole_x": (lambda v: True, "[m]"),
+    "foot_length": (lambda v: v > 0, "> 0 [m]"),
+    "hip_ahead": (lambda v: True, "[m]"),
+    "foot_width": (lambda v: v >= 0, ">= 0 [m]"),
+}
+
+
+def _check_geometry(g: LegGeometry) -> None:
+    """Refuse leg measures no robot has: a length that is not finite or of the wrong sign."""
+    for name, (ok, what) in _GEOMETRY.items():
+        _need(f"geometry.{name}", getattr(g, name), ok, what)
+
+
+def _geometry(d: object) -> LegGeometry:
+    """The leg measures a style file holds (missing optional ones at their defaults)."""
+    if not isinstance(d, dict):
+        raise ConfigError(f"geometry must be an object of the leg's measures (got {_shown(d)})")
+    known = [f.name for f in fields(LegGeometry)]
+    unknown = sorted(set(d) - set(known))
+    if unknown:
+        raise ConfigError(f"geometry.{unknown[0]} is not a leg measure; valid: {', '.join(known)}")
+    kw = {}
+    for f in fields(LegGeometry):
+        if f.name in d:
+            kw[f.name] = as_number(d[f.name], f"geometry.{f.name}")
+        elif f.default is MISSING:
+            raise ConfigError(f"geometry.{f.name} is missing")
+    return LegGeometry(**kw)
+
+
+def longest_step(geom: LegGeometry, knee_min_deg: float = KNEE_MIN_DEG) -> float:
+    """The longest step [m] the legs ``geom`` make with the knee bent at least
+    ``knee_min_deg`` [deg] (:func:`hip_height` refuses one as long or longer): a style
+    at scale 1 steps shorter."""
+    return float(2 * 0.9 * geom.leg * np.cos(np.radians(knee_min_deg) / 2))
 
 
 def hip_height(geom: LegGeometry, step_length: float, knee_min_deg: float = KNEE_MIN_DEG) -> float:
