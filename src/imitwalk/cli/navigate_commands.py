@@ -138,15 +138,13 @@ def _stepping_run(args: argparse.Namespace) -> tuple[RunDir, LoadedRun, Robot]:
 
 
 def _out_dir(args: argparse.Namespace, rd: RunDir) -> Path:
-    """The folder to write to (``--out``, default ``RUN/navigate``); refuses a file."""
-    from imitwalk.errors import ConfigError
-
-    out = Path(args.out) if args.out else Path(rd.path) / "navigate"
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out}: exists and is not a folder")
+    """The folder to write to (``--out``, default ``RUN/navigate``); refuses, before the
+    walks, a file or a folder that cannot be written (:meth:`RunDir.check_writable
+    <imitwalk.runs.RunDir.check_writable>`)."""
     from imitwalk.runs import RunDir
 
-    RunDir(out).check_writable("--out")  # before the walks, not after them
+    out = Path(args.out) if args.out else Path(rd.path) / "navigate"
+    RunDir(out).check_writable("--out")
     return out
 
 

@@ -21,8 +21,9 @@ from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.sim.types import SimOptions
+from imitwalk.step.fields import as_number
 from imitwalk.step.schedule import START_STEPS, nominal_distance, nominal_track, start_seconds
-from imitwalk.step.style import GaitStyle, as_number, longest_step
+from imitwalk.step.style import GaitStyle, longest_step
 
 #: The format version ``style.json`` is written in (and the newest :meth:`StepGait.load`
 #: reads; a file without one reads as 1). 2: the style's ``stride_share`` (a format-1

@@ -23,6 +23,16 @@ import numpy as np
 
 from imitwalk.errors import ConfigError
 from imitwalk.retarget.params import LegGeometry
+from imitwalk.step.fields import (
+    as_array,
+    as_number,
+    check_geometry,
+    entry,
+    need,
+    profile,
+    read_geometry,
+    shown,
+)
 
 if TYPE_CHECKING:  # the template is read from mocap (SciPy); a style alone needs neither
     from imitwalk.retarget.template import GaitTemplate
@@ -157,7 +167,7 @@ class GaitStyle:
         """
         try:
             if not isinstance(d, dict):
-                raise ConfigError(f"the style must be an object (got {_shown(d)})")
+                raise ConfigError(f"the style must be an object (got {shown(d)})")
             unknown = sorted(set(d) - {f.name for f in fields(cls)})
             if unknown:
                 valid = ", ".join(f.name for f in fields(cls))
@@ -167,18 +177,18 @@ class GaitStyle:
                 if f.name in ("upper", "human", "geometry"):
                     continue
                 if f.name in ("swing_x", "swing_z"):
-                    kw[f.name] = _array(_entry(d, f.name), f.name)
+                    kw[f.name] = as_array(entry(d, f.name), f.name)
                 elif f.name in d or f.default is MISSING:
-                    kw[f.name] = as_number(_entry(d, f.name), f.name)
-            upper = _entry(d, "upper")
+                    kw[f.name] = as_number(entry(d, f.name), f.name)
+            upper = entry(d, "upper")
             if not isinstance(upper, dict):
-                raise ConfigError(f"upper must be an object of role: profile (got {_shown(upper)})")
-            kw["upper"] = {k: _array(v, f"upper.{k}") for k, v in upper.items()}
-            human = _entry(d, "human")
+                raise ConfigError(f"upper must be an object of role: profile (got {shown(upper)})")
+            kw["upper"] = {k: as_array(v, f"upper.{k}") for k, v in upper.items()}
+            human = entry(d, "human")
             if not isinstance(human, dict):
-                raise ConfigError(f"human must be an object (got {_shown(human)})")
+                raise ConfigError(f"human must be an object (got {shown(human)})")
             kw["human"] = dict(human)
-            kw["geometry"] = _geometry(_entry(d, "geometry"))
+            kw["geometry"] = read_geometry(entry(d, "geometry"))
             return cls(**kw)
         except ConfigError as exc:
             raise ConfigError(f"{where}{exc}") from None
@@ -206,25 +216,25 @@ class GaitStyle:
         """
         g = self.geometry
         if not isinstance(g, LegGeometry):
-            raise ConfigError(f"geometry must be a robot's leg measures (got {_shown(g)})")
-        _check_geometry(g)
-        _need("step_time", self.step_time, lambda v: v > 0, "> 0 [s]")
+            raise ConfigError(f"geometry must be a robot's leg measures (got {shown(g)})")
+        check_geometry(g)
+        need("step_time", self.step_time, lambda v: v > 0, "> 0 [s]")
         st = self.step_time
-        _need(
+        need(
             "double_support",
             self.double_support,
             lambda v: 0 < v < st,
             f"with 0 < double_support < step_time ({st:g} s) [s]",
         )
-        _need("step_length", self.step_length, lambda v: True, "[m] (negative: backward)")
-        _need("step_width", self.step_width, lambda v: v > 0, "> 0 [m]")
-        _need(
+        need("step_length", self.step_length, lambda v: True, "[m] (negative: backward)")
+        need("step_width", self.step_width, lambda v: v > 0, "> 0 [m]")
+        need(
             "clearance",
             self.clearance,
             lambda v: 0 <= v < g.leg,
             f"with 0 <= clearance < geometry.leg ({g.leg:g} m) [m]",
         )
-        _need(
+        need(
             "hip_height",
             self.hip_height,
             lambda v: 0 < v <= g.hip_height,
@@ -236,30 +246,30 @@ class GaitStyle:
                 f"hip_height + geometry.hip_z (the pelvis height) must be > 0 [m] "
                 f"(got {self.hip_height:g} + {g.hip_z:g})"
             )
-        _need(
+        need(
             "turn",
             self.turn,
             lambda v: abs(v) <= MAX_TURN + TURN_TOLERANCE,
             f"with |turn| <= MAX_TURN ({MAX_TURN:.4f} rad, {np.degrees(MAX_TURN):g} deg) "
             "[rad per cycle]",
         )
-        _need(
+        need(
             "stride_share",
             self.stride_share,
             lambda v: 0 < v <= 1,
             "(a share of the clip's stride): expected 0 < stride_share <= 1",
         )
         for name in ("swing_x", "swing_z"):
-            _profile(name, getattr(self, name), least=2)
+            profile(name, getattr(self, name), least=2)
         if len(self.swing_x) != len(self.swing_z):
             raise ConfigError(
                 f"swing_x and swing_z must sample the swing alike (got {len(self.swing_x)} "
                 f"and {len(self.swing_z)} samples)"
             )
         if not isinstance(self.upper, dict):
-            got = _shown(self.upper)
+            got = shown(self.upper)
             raise ConfigError(f"upper must be a mapping of role: profile (got {got})")
-        sizes = {role: _profile(f"upper.{role}", prof) for role, prof in self.upper.items()}
+        sizes = {role: profile(f"upper.{role}", prof) for role, prof in self.upper.items()}
         if len(set(sizes.values())) > 1:
             got = ", ".join(f"{k} {n}" for k, n in sizes.items())
             raise ConfigError(f"upper's profiles must sample the gait alike (got {got} samples)")
@@ -270,12 +280,12 @@ class GaitStyle:
         finite if given and, with the turn and the step, of a consistent sign."""
         h = self.human
         if not isinstance(h, dict):
-            raise ConfigError(f"human must be a mapping of the clip's figures (got {_shown(h)})")
+            raise ConfigError(f"human must be a mapping of the clip's figures (got {shown(h)})")
         for key, (ok, what) in _HUMAN.items():
             if key not in h:
                 raise ConfigError(f"human.{key} is missing (the clip's {key} {what.split()[-1]})")
-            _need(f"human.{key}", h[key], ok, what)
-        _need("human.turn_deg", h.get("turn_deg", 0.0), lambda v: True, "[deg per cycle]")
+            need(f"human.{key}", h[key], ok, what)
+        need("human.turn_deg", h.get("turn_deg", 0.0), lambda v: True, "[deg per cycle]")
         clip = float(h.get("turn_deg", 0.0))
         # forward, the style turns its clip's way; played backward, the other way
         if self.turn and clip and self.step_length:
@@ -286,94 +296,6 @@ class GaitStyle:
                     f"with the clip's turn (human.turn_deg {clip:+g}): a {way} style turns "
                     + ("against its clip" if self.backward else "its clip's way")
                 )
-
-
-def _shown(v: object) -> str:
-    """``v`` as a message shows it: a number as ``%g``, anything else its short repr."""
-    if isinstance(v, float | int | np.floating | np.integer) and not isinstance(v, bool):
-        return f"{float(v):g}"
-    text = repr(v)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def _entry(d: dict, key: str) -> object:
-    """``d[key]``, or a :class:`ConfigError` saying it is missing."""
-    if key not in d:
-        raise ConfigError(f"{key} is missing")
-    return d[key]
-
-
-def as_number(v: object, name: str) -> float:
-    """``v`` as a float (a :class:`ConfigError` naming ``name`` if it is not a number;
-    not-finite ones pass, for :func:`_need` to say their range)."""
-    if isinstance(v, bool) or not isinstance(v, int | float | np.floating | np.integer):
-        raise ConfigError(f"{name} must be a number (got {_shown(v)})")
-    return float(v)
-
-
-def _array(v: object, name: str) -> np.ndarray:
-    """``v`` as a float array (a :class:`ConfigError` naming ``name`` if it is not one)."""
-    try:
-        return np.asarray(v, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be a list of numbers (got {_shown(v)})") from None
-
-
-def _need(name: str, v: object, ok: Callable[[float], bool], what: str) -> None:
-    """Refuse ``v`` unless it is a finite number for which ``ok`` holds (``what``: its
-    range and unit, as the message says it)."""
-    x = as_number(v, name)
-    if not (np.isfinite(x) and ok(x)):
-        raise ConfigError(f"{name} must be a finite number {what} (got {_shown(x)})")
-
-
-def _profile(name: str, prof: object, least: int = 1) -> int:
-    """Refuse a profile that is not a 1-D array of at least ``least`` finite numbers; its
-    length."""
-    a = np.asarray(prof)
-    if a.ndim != 1 or a.dtype.kind not in "fiu" or len(a) < least or not np.isfinite(a).all():
-        shape = f"{len(a)} samples" if a.ndim == 1 else f"shape {a.shape}"
-        numbers = a.ndim == 1 and a.dtype.kind in "fiu"
-        bad = " with a value that is not finite" if numbers and not np.isfinite(a).all() else ""
-        need = "a non-empty list of" if least == 1 else f"a list of at least {least}"
-        raise ConfigError(f"{name} must be {need} finite numbers (got {shape}{bad})")
-    return len(a)
-
-
-#: The robot's leg measures a style keeps (:class:`LegGeometry`), each with its range.
-_GEOMETRY: dict[str, tuple[Callable[[float], bool], str]] = {
-    "hip_y": (lambda v: v >= 0, ">= 0 [m]"),
-    "hip_z": (lambda v: True, "[m]"),
-    "leg": (lambda v: v > 0, "> 0 [m]"),
-    "ankle": (lambda v: v >= 0, ">= 0 [m]"),
-    "sole_x": (lambda v: True, "[m]"),
-    "foot_length": (lambda v: v > 0, "> 0 [m]"),
-    "hip_ahead": (lambda v: True, "[m]"),
-    "foot_width": (lambda v: v >= 0, ">= 0 [m]"),
-}
-
-
-def _check_geometry(g: LegGeometry) -> None:
-    """Refuse leg measures no robot has: a length that is not finite or of the wrong sign."""
-    for name, (ok, what) in _GEOMETRY.items():
-        _need(f"geometry.{name}", getattr(g, name), ok, what)
-
-
-def _geometry(d: object) -> LegGeometry:
-    """The leg measures a style file holds (missing optional ones at their defaults)."""
-    if not isinstance(d, dict):
-        raise ConfigError(f"geometry must be an object of the leg's measures (got {_shown(d)})")
-    known = [f.name for f in fields(LegGeometry)]
-    unknown = sorted(set(d) - set(known))
-    if unknown:
-        raise ConfigError(f"geometry.{unknown[0]} is not a leg measure; valid: {', '.join(known)}")
-    kw = {}
-    for f in fields(LegGeometry):
-        if f.name in d:
-            kw[f.name] = as_number(d[f.name], f"geometry.{f.name}")
-        elif f.default is MISSING:
-            raise ConfigError(f"geometry.{f.name} is missing")
-    return LegGeometry(**kw)
 
 
 def longest_step(geom: LegGeometry, knee_min_deg: float = KNEE_MIN_DEG) -> float:
