@@ -141,6 +141,26 @@ def test_friction_and_mass_and_kp_options(robot):
     assert np.allclose(p.model.actuator_biasprm[:, 1], -p.model.actuator_gainprm[:, 0])
 
 
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_perturbed_robots_centre_of_mass_moves_with_it(robot, seed):
+    """The truth's centre of mass is the perturbed bodies' (MuJoCo's ``subtree_com``
+    divides by the compiled, nominal mass: 5 % off on a robot 5 % lighter)."""
+    import mujoco
+
+    from imitwalk.sim.truth import body_truth
+
+    p = MujocoPlant(robot, SimOptions(mass_scale=0.9, mass_jitter=0.15, seed=seed))
+    assert p.mass == pytest.approx(p.model.body_mass.sum())
+    p.reset()
+    before = body_truth(p).com
+    p.data.qpos[0] += 2.0  # the whole robot carried 2 m along x
+    mujoco.mj_forward(p.model, p.data)
+    after = body_truth(p).com
+    assert after - before == pytest.approx([2.0, 0.0, 0.0], abs=1e-9)
+    weighted = np.average(p.data.xipos, axis=0, weights=p.model.body_mass)
+    assert after == pytest.approx(weighted, abs=1e-12)
+
+
 def test_heavier_robot_presses_harder(robot):
     _, light = _hold(robot, 1.0)
     _, heavy = _hold(robot, 1.0, mass_scale=1.1)

@@ -87,9 +87,15 @@ class MujocoPlant:
         if opt.friction is not None:
             m.geom_friction[:, 0] = opt.friction
         m.geom_friction[:, 0] *= opt.friction_scale
+        # Masses are perturbed after compiling: the model's derived constants (its
+        # ``body_subtreemass``, so ``subtree_com`` and ``subtree_linvel``) stay the
+        # nominal robot's. Read the perturbed robot's mass and centre of mass from
+        # :attr:`mass` and :meth:`com`, never from those.
         m.body_mass[:] *= scale
         m.body_inertia[:] *= scale[:, None]
         m.body_ipos[m.body(robot.torso).id] += np.asarray(opt.com_shift, dtype=float)
+        #: the perturbed robot's whole mass [kg]
+        self.mass = float(m.body_mass.sum())
         self._jid = np.array([m.joint(j).id for j in robot.mj_joints])
         self._qadr = m.jnt_qposadr[self._jid]
         act_for = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
@@ -191,6 +197,13 @@ class MujocoPlant:
         """``(n,)`` each servo's torque limit [Nm] (:attr:`Robot.torque_limit`: its force
         range and its joint's, ``inf`` if none)."""
         return self.robot.torque_limit.copy()
+
+    def com(self) -> np.ndarray:
+        """``(3,)`` the perturbed robot's centre of mass now, in the world frame [m]: its
+        bodies' centres weighted by their perturbed masses (``subtree_com`` divides by
+        the nominal robot's mass, see ``__init__``)."""
+        m, d = self.model, self.data
+        return np.asarray(m.body_mass @ d.xipos / self.mass)
 
     def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Ground truth torso position ``(3,)`` [m] and quaternion ``(4,)`` (w, x, y, z)."""

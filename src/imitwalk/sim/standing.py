@@ -128,11 +128,6 @@ class StandResult:
         )
 
 
-def _root(plant: MujocoPlant) -> int:
-    m = plant.model
-    return int(m.body_rootid[m.body(plant.robot.torso).id])
-
-
 def stand_test(
     robot: Robot, seconds: float = 10.0, options: SimOptions | None = None
 ) -> StandResult:
@@ -164,7 +159,7 @@ def stand_test(
         final_tilt_deg=float(tilt[-1]),
         tipping_deg_per_s=tipping,
         foot_force_sum_n=float(per_side.sum()),
-        weight_n=float(plant.model.body_subtreemass[_root(plant)] * g),
+        weight_n=plant.mass * g,
         left_n=float(per_side[0]),
         right_n=float(per_side[1]),
         both_feet_in_contact=bool((per_side > 0.05 * per_side.sum()).all()),

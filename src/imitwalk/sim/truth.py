@@ -42,10 +42,9 @@ def _point(plant: MujocoPlant, name: str) -> np.ndarray:
 
 def body_truth(plant: MujocoPlant) -> BodyTruth:
     """The plant's :class:`BodyTruth` now (after its last step or reset)."""
-    d = plant.data
     pos, quat = plant.torso_pose()
     return BodyTruth(
-        com=d.subtree_com[0].copy(),
+        com=plant.com(),
         soles={side: _point(plant, plant.robot.soles[side]) for side in ("l", "r")},
         torso_pos=pos,
         torso_quat=quat,
