@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -12,6 +13,7 @@ from imitwalk.robots import load_robot
 from imitwalk.sim.metrics import tilt_deg
 from imitwalk.sim.mujoco import MujocoPlant, Plant, SimOptions, make_plant, playback
 from imitwalk.sim.standing import stand_test
+from imitwalk.sim.truth import body_truth
 
 
 @pytest.fixture(scope="module")
@@ -145,10 +147,6 @@ def test_friction_and_mass_and_kp_options(robot):
 def test_a_perturbed_robots_centre_of_mass_moves_with_it(robot, seed):
     """The truth's centre of mass is the perturbed bodies' (MuJoCo's ``subtree_com``
     divides by the compiled, nominal mass: 5 % off on a robot 5 % lighter)."""
-    import mujoco
-
-    from imitwalk.sim.truth import body_truth
-
     p = MujocoPlant(robot, SimOptions(mass_scale=0.9, mass_jitter=0.15, seed=seed))
     assert p.mass == pytest.approx(p.model.body_mass.sum())
     p.reset()
