@@ -302,7 +302,13 @@ def longest_step(geom: LegGeometry, knee_min_deg: float = KNEE_MIN_DEG) -> float
     """The longest step [m] the legs ``geom`` make with the knee bent at least
     ``knee_min_deg`` [deg] (:func:`hip_height` refuses one as long or longer): a style
     at scale 1 steps shorter."""
-    return float(2 * 0.9 * geom.leg * np.cos(np.radians(knee_min_deg) / 2))
+    return float(2 * (0.9 * _reach(geom, knee_min_deg)))
+
+
+def _reach(geom: LegGeometry, knee_min_deg: float) -> float:
+    """One leg's reach [m] with the knee bent ``knee_min_deg`` [deg] (thigh and shank
+    taken as equal, so a knee bent by κ shortens the leg to ``leg·cos(κ/2)``)."""
+    return float(geom.leg * np.cos(np.radians(knee_min_deg) / 2))
 
 
 def hip_height(geom: LegGeometry, step_length: float, knee_min_deg: float = KNEE_MIN_DEG) -> float:
@@ -314,15 +320,14 @@ def hip_height(geom: LegGeometry, step_length: float, knee_min_deg: float = KNEE
     Raises:
         ConfigError: the legs cannot make the step at all (which limit says why).
     """
-    reach = geom.leg * np.cos(np.radians(knee_min_deg) / 2)
-    half = step_length / 2
-    if half >= 0.9 * reach:
+    reach = _reach(geom, knee_min_deg)
+    if step_length >= longest_step(geom, knee_min_deg):
         raise ConfigError(
             f"a step of {step_length:.3f} m is beyond this robot's legs: with the knee bent "
             f"{knee_min_deg:g} deg each leg reaches {reach:.3f} m (leg {geom.leg:.3f} m); "
             "walk a shorter stride (--forward)"
         )
-    return float(np.sqrt(reach**2 - half**2) + geom.ankle)
+    return float(np.sqrt(reach**2 - (step_length / 2) ** 2) + geom.ankle)
 
 
 def style_from_template(
