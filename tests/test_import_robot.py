@@ -286,3 +286,19 @@ def test_g1_starts_the_stepping_gait_without_a_spin_or_a_false_tilt(drafted, cap
             tilt_err = max(tilt_err, abs(t.roll - true[0]), abs(t.pitch - true[1]))
     assert spin < 1.0  # [rad/s]
     assert np.degrees(tilt_err) < 8.0
+
+
+def test_an_existing_joint_map_is_kept_unless_forced(tmp_path, capsys):
+    """``robot import`` never overwrites a joint map the user may have edited: it refuses
+    in one line (exit 2) and writes nothing; ``--force`` replaces it."""
+    from imitwalk.robots import BUILTIN
+
+    out = tmp_path / "mine.json"
+    out.write_text('{"edited": true}\n')
+    xml = str(BUILTIN["hoap2"].parent / "hoap2.xml")
+    assert main(["robot", "import", xml, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "exists" in err[0] and "--force" in err[0]
+    assert out.read_text() == '{"edited": true}\n'
+    assert main(["robot", "import", xml, "--out", str(out), "--force"]) == 0
+    assert json.loads(out.read_text())["name"] == "hoap2"

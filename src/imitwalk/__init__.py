@@ -12,10 +12,16 @@ MuJoCo)::
     robot = iw.load_robot("hoap2")
     summary = iw.learn(iw.default_clip(), robot, "RUN")  # what `imitwalk learn` does
     judged = iw.evaluate_run("RUN", robot, iw.load_protocol("eval"), seeds=40)  # a ProtocolVerdict
+
+``iw.retarget`` is always the function :func:`imitwalk.retarget.pipeline.retarget`, never
+the subpackage of the same name; reach the subpackage by ``from imitwalk.retarget import
+...`` or ``importlib.import_module("imitwalk.retarget")`` (``import imitwalk.retarget as
+m`` reads the attribute, and so gives the function).
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 from typing import Any
 
@@ -32,7 +38,7 @@ from imitwalk.errors import (
     SensorError,
 )
 
-__version__ = "0.11.1"
+__version__ = "0.12.0"
 
 #: The flat API: name -> the module that defines it, or (module, its name there); each is
 #: imported on first use.
@@ -42,7 +48,7 @@ _LAZY: dict[str, str | tuple[str, str]] = {
     "Motion": "imitwalk.mocap",
     "load_robot": "imitwalk.robots",
     "Robot": "imitwalk.robots",
-    "retarget": "imitwalk.retarget",
+    "retarget": ("imitwalk.retarget.pipeline", "retarget"),
     "RetargetConfig": "imitwalk.retarget",
     "Reference": "imitwalk.retarget",
     "learn": "imitwalk.step.pipeline",
@@ -79,10 +85,17 @@ _LAZY: dict[str, str | tuple[str, str]] = {
 }
 
 
+# The subpackage ``imitwalk.retarget`` (NumPy only until one of its names is used) shares
+# its name with the function ``retarget``. Python binds a subpackage as an attribute of
+# its parent once, on the subpackage's first import, which would hide the function from
+# then on. So import it now and drop that binding: the name then resolves through
+# ``__getattr__`` to the function, whatever is imported later and in what order.
+importlib.import_module("imitwalk.retarget")
+globals().pop("retarget", None)
+
+
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
-        import importlib
-
         where = _LAZY[name]
         module, attr = where if isinstance(where, tuple) else (where, name)
         value = getattr(importlib.import_module(module), attr)

@@ -50,8 +50,8 @@ class RunError(ImitwalkError):
 
 
 class SensorError(ImitwalkError):
-    """A sensor vector handed to an exported controller has the wrong length or a value
-    that is not finite."""
+    """A sensor vector handed to an exported controller has the wrong length, or a value
+    that is not a finite real number within the runtime's bound on a reading."""
 
 
 def unknown_name(

@@ -193,6 +193,49 @@ class RunDir:
         elif not writable_folder(self.path):
             raise RunError(f"{flag} {self.path}: cannot write in it; choose another {flag}")
 
+    def check_new(self, resume: bool, flag: str = "--out") -> None:
+        """Refuse, before any work starts, a folder a run would be learned into that
+        holds files already: files that are not an imitwalk run (learning would overwrite a
+        user's ``metrics.json`` or ``log.jsonl``) or, without ``resume``, a run. A new or
+        empty folder passes. ``flag`` names the folder's command-line argument.
+
+        Raises:
+            RunError: one line naming the folder (and the first files it holds).
+        """
+        if not self.path.is_dir():
+            return
+        held = sorted(p.name for p in self.path.iterdir())
+        if not held:
+            return
+        if not self.holds_run():
+            shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+            raise RunError(
+                f"{flag} {self.path} holds files that are not an imitwalk run ({shown}); give "
+                "an empty or new folder, or --resume for an imitwalk run"
+            )
+        if not resume:
+            raise RunError(
+                f"{self.path} already holds a run; pass --resume or choose another {flag}"
+            )
+
+    def holds_run(self) -> bool:
+        """True if the folder holds a learning run's files, finished or not: a
+        ``config.json`` naming its learner or settings, a checkpoint (``checkpoint.json``,
+        ``cma.pkl``) or a stepping gait (``style.json``), here or in a subfolder (a
+        reference choice's passes, :mod:`imitwalk.learning.refchoice`)."""
+        folders = [self, *(RunDir(p) for p in self.path.iterdir() if p.is_dir())]
+        return any(f._run_files() for f in folders)
+
+    def _run_files(self) -> bool:
+        """True if this folder itself holds a run's files (:meth:`holds_run`)."""
+        if any(self.exists(m) for m in ("checkpoint.json", "cma.pkl", "style.json")):
+            return True
+        try:
+            config = json.loads(self.file("config.json").read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError, RecursionError):
+            return False
+        return isinstance(config, dict) and ("learner" in config or "learn" in config)
+
     def file(self, name: str) -> Path:
         """Path of a file in the run folder."""
         return self.path / name

@@ -1,6 +1,7 @@
-"""The command line's numbers, checked before any work starts: a walk's length, the
-robots and processes to use, and a stride scale. Each refusal is one line that names the
-flag and the valid range (:class:`~imitwalk.errors.ConfigError`, exit status 2)."""
+"""The command line's numbers and names, checked before any work starts: a walk's length,
+the robots and processes to use, a stride scale and an output folder's name. Each refusal
+is one line that names the flag and the valid range (:class:`~imitwalk.errors.ConfigError`,
+exit status 2)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ __all__ = [
     "MAX_SCALE",
     "MIN_SECONDS",
     "check_count",
+    "check_folder_name",
     "check_joint_map_alone",
     "check_scale",
     "check_seconds",
@@ -39,6 +41,12 @@ def check_count(count: int, flag: str) -> None:
     """Refuse a count of robots (or of anything a command needs one of) under 1."""
     if count < 1:
         raise ConfigError(f"{flag} {count}: expected >= 1")
+
+
+def check_folder_name(name: str, flag: str) -> None:
+    """Refuse an empty folder name (it would be the working directory)."""
+    if not name:
+        raise ConfigError(f"{flag} '': give the name of a folder (an empty or new one)")
 
 
 def check_workers(workers: int | None) -> None:

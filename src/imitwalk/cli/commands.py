@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from imitwalk.cli.progress import emit, progress
-from imitwalk.cli.robot_args import recorded_robot, robot_from, standing_robot
+from imitwalk.cli.resume_checks import check_out, check_resumed_clip, check_resumed_robot
+from imitwalk.cli.robot_args import recorded_robot, robot_from, robot_label
 
 if TYPE_CHECKING:
     from imitwalk.learning.refchoice import Choice
@@ -87,6 +88,13 @@ def playback(args: argparse.Namespace) -> int:
         args.robot = ref.provenance.robot or ref.robot
         args.joint_map = ref.provenance.joint_map
     robot = robot_from(args)
+    if ref.robot != robot.name or tuple(ref.joint_names) != robot.joint_names:
+        from imitwalk.errors import MocapError
+
+        raise MocapError(
+            f"{args.reference}: a reference of robot {ref.robot!r}, not {robot.name!r} "
+            f"(retarget the clip with --robot {robot_label(args)})"
+        )
     seeds = list(range(args.models))
     progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
     runs = play_reference(
@@ -118,10 +126,19 @@ def _with_command(cfg: RetargetConfig, args: argparse.Namespace) -> RetargetConf
 
 def learn(args: argparse.Namespace) -> int:
     from imitwalk.learning.jointspace import learn_joint_space
+    from imitwalk.mocap import default_clip
     from imitwalk.retarget import Reference
     from imitwalk.runs import RunDir
+    from imitwalk.sim.standing import require_standing
 
-    robot = standing_robot(args)  # every variant, before any work
+    rd = RunDir(args.out)
+    check_out(args, rd)  # every variant, before any work
+    robot = robot_from(args)
+    if args.resume:  # a run goes on with the robot and clip it started with
+        check_resumed_robot(args, rd, robot)
+        if args.file:
+            check_resumed_clip(rd, args.file)
+    require_standing(robot, robot_label(args))
     args.variant = _variant(args)
     if args.variant == "step":
         return _learn_step(args, robot)
@@ -134,16 +151,17 @@ def learn(args: argparse.Namespace) -> int:
         )
     rt_set, learn_set = _split_settings(args.set)
     cfg, run = _joint_space_learner(args, learn_set)
-    rd = RunDir(args.out)
-    rd.check_writable()
     resumed = _resumed(args, rd)
     rcfg = _retarget_config(rt_set, bool(args.reference or resumed))
     if resumed:
         ref = Reference.load(rd.file("reference.npz"))
+        _unused_clip_flags(args)
         progress(f"learn: resuming {rd.path}")
     elif args.reference:
         ref = Reference.load(args.reference)
     else:
+        if args.resume and not args.file:  # the clip is read again: the run's own
+            check_resumed_clip(rd, str(default_clip()))
         motion, rcfg = _motion(args, robot), _with_command(rcfg, args)
         named = recorded_robot(args)
         summary, choice = learn_joint_space(
@@ -265,10 +283,10 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
     cfg = apply_overrides(StepLearnConfig(seed=args.seed), args.set)
     load_protocol(cfg.protocol)  # an unknown one refused before any work
     rd = RunDir(args.out)
-    rd.check_writable()
     motion = None
     if args.resume:
         resumed_gait(rd.path, args.backward)  # its direction is its own: refused at once
+        _unused_clip_flags(args)
         progress(f"learn: resuming {rd.path}")
     else:
         motion = _motion(args, robot)
@@ -288,6 +306,14 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
         backward=args.backward,
     )
     return _learned(summary, args, rd)
+
+
+def _unused_clip_flags(args: argparse.Namespace) -> None:
+    """Say which clip flags a resumed run leaves unused (it walks its own gait)."""
+    flags = ("skeleton", "units", "up", "joint_names")
+    given = [f"--{f.replace('_', '-')}" for f in flags if getattr(args, f, None) is not None]
+    if given:
+        progress(f"learn: {', '.join(given)}: not used, a resumed run keeps its own clip's gait")
 
 
 def _learned(

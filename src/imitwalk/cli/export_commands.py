@@ -15,12 +15,13 @@ def export(args: argparse.Namespace) -> int:
     from imitwalk import readback
     from imitwalk.judge.export import export_run
     from imitwalk.runs import RunDir
-    from imitwalk.runtime.bundle import MANIFEST
+    from imitwalk.runtime.bundle import MANIFEST, check_out
 
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     check_scale(args.scale)
-    RunDir(args.out).check_writable("--out")  # before anything is built
+    check_out(args.out)  # before anything is built: a file, a link, a folder of other things
+    RunDir(args.out).check_writable("--out")  # its parent missing, or not writable
     args.robot, args.joint_map = run_robot(rd, cfg)
     robot = robot_from(args)
     out = export_run(rd.path, robot, args.out, args.controller, args.scale)
@@ -49,14 +50,21 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="write a run's controller as a folder that imitwalk.runtime plays on a robot",
     )
     p.add_argument("run_dir", help="a stepping run (learn) or a PPO run (rl)")
-    p.add_argument("--out", required=True, help="the folder to write (replaces an earlier export)")
+    p.add_argument(
+        "--out",
+        required=True,
+        help="the folder to write: new, empty, or an earlier export (replaced); not a symlink",
+    )
     p.add_argument(
         "--controller",
         default=None,
         help="which of the run's controllers (default: learned; rl for a PPO run)",
     )
     p.add_argument(
-        "--scale", type=float, default=None, help="the stride scale (default: the one reached)"
+        "--scale",
+        type=float,
+        default=None,
+        help="the stride scale, one the run learned (default: the one reached)",
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=export)

@@ -14,7 +14,7 @@ from imitwalk.cli.arg_checks import (
     check_workers,
 )
 from imitwalk.cli.progress import emit, progress
-from imitwalk.cli.robot_args import robot_from, run_robot
+from imitwalk.cli.robot_args import recorded_robot, robot_from, robot_label, run_robot
 
 if TYPE_CHECKING:
     from imitwalk.robots import Robot
@@ -41,9 +41,7 @@ def evaluate(args: argparse.Namespace) -> int:
     rd = RunDir(args.run_dir)
     cfg = rd.read_json("config.json")
     rd.check_writable("RUN_DIR")  # the verdict is written there
-    if args.robot is None:
-        args.robot, args.joint_map = run_robot(rd, cfg)
-    robot = robot_from(args)
+    robot = _judged_robot(args, rd, cfg)
     if args.push_recovery:
         return _push_recovery(args, rd, robot)
     protocol = load_protocol(args.protocol)
@@ -77,9 +75,47 @@ def evaluate(args: argparse.Namespace) -> int:
         if (line := side.explained()) is not None:
             progress(f"  {'':>10}  falls saved by one factor at nominal: {line}")
     scale = "" if args.scale is None else f"_scale{args.scale:g}"
-    rd.write_json(f"protocol_{protocol.name}{scale}.json", out.to_dict())
-    emit(out.to_dict(), args.json)
+    doc = {**out.to_dict(), "robot": _robot_record(args, robot)}
+    rd.write_json(f"protocol_{protocol.name}{scale}.json", doc)
+    emit(doc, args.json)
     return 0
+
+
+def _judged_robot(args: argparse.Namespace, rd: RunDir, cfg: dict) -> Robot:
+    """The robot a run is judged on: the one it learned on (``args.robot`` and
+    ``args.joint_map`` set to it), or ``--robot``, which must be a robot of the same name
+    (another joint map or MJCF of it, e.g. stronger knees, may be given).
+
+    Raises:
+        ConfigError: ``--robot`` names another robot than the run learned on.
+    """
+    from imitwalk.errors import ConfigError
+
+    if args.robot is None:
+        args.robot, args.joint_map = run_robot(rd, cfg)
+        return robot_from(args)
+    robot = robot_from(args)
+    own = cfg.get("robot")
+    if not isinstance(own, str):  # not in its config.json: the robot its files record
+        name, joint_map = run_robot(rd, cfg)
+        own = robot_from(argparse.Namespace(robot=name, joint_map=joint_map)).name
+    if robot.name != own:
+        raise ConfigError(
+            f"--robot {robot_label(args)}: {rd.path} learned on {own!r}, not {robot.name!r}; "
+            f"judge it on {own} (a joint map or MJCF of {own} may be given)"
+        )
+    return robot
+
+
+def _robot_record(args: argparse.Namespace, robot: Robot) -> dict:
+    """The robot a verdict was judged on, as its file records it
+    (:class:`~imitwalk.judge.verdict.JudgedRobot`)."""
+    from dataclasses import asdict
+
+    from imitwalk.judge.verdict import JudgedRobot
+
+    where = recorded_robot(args)
+    return asdict(JudgedRobot(robot.name, where.robot or robot.name, where.joint_map))
 
 
 def _push_recovery(args: argparse.Namespace, rd: RunDir, robot: Robot) -> int:
@@ -93,8 +129,9 @@ def _push_recovery(args: argparse.Namespace, rd: RunDir, robot: Robot) -> int:
         progress(
             f"  {name:>10}: least kick survived " + ", ".join(f"{d} {v:.2f}" for d, v in least)
         )
-    rd.write_json("push_recovery.json", out.to_dict())
-    emit(out.to_dict(), args.json)
+    doc = {**out.to_dict(), "robot": _robot_record(args, robot)}
+    rd.write_json("push_recovery.json", doc)
+    emit(doc, args.json)
     return 0
 
 
@@ -108,7 +145,7 @@ def report(args: argparse.Namespace) -> int:
     rd.check_writable("RUN_DIR")  # report.html is written there
     robot = None
     if args.robot:
-        robot = robot_from(args)
+        robot = _judged_robot(args, rd, rd.read_json("config.json"))
     path = write_report(rd.path, robot, seconds=args.seconds, progress=progress)
     emit({"report": str(path)}, args.json)
     return 0

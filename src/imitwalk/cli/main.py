@@ -134,6 +134,9 @@ def _add_robot(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     imp = rsub.add_parser("import", help="draft a joint map from an MJCF file (never edits it)")
     imp.add_argument("mjcf", help="the robot's MJCF .xml")
     imp.add_argument("--out", required=True, help="the joint map to write (.json)")
+    imp.add_argument(
+        "--force", action="store_true", help="replace --out if it exists (its edits are lost)"
+    )
     imp.add_argument("--json", action="store_true", help="print JSON")
     imp.set_defaults(func=robot_commands.robot_import)
 
@@ -262,7 +265,13 @@ def _add_report(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
     """The ``report`` subcommand's arguments."""
     rp = sub.add_parser("report", help="write RUN_DIR/report.html (figures, film strips, video)")
     rp.add_argument("run_dir", help="a run folder written by learn")
-    rp.add_argument("--seconds", type=float, default=10.0, help="length of the replays (10)")
+    rp.add_argument(
+        "--seconds",
+        type=float,
+        default=10.0,
+        help="length of the replays [s] (10; a stepping run's last at least to its first "
+        "kick and two cycles more)",
+    )
     rp.add_argument("--robot", default=None, help="robot (default: the run's)")
     rp.add_argument("--joint-map", help="joint-map JSON for an MJCF robot")
     rp.add_argument("--json", action="store_true", help="print JSON")

@@ -68,7 +68,8 @@ def robot_stand(args: argparse.Namespace) -> int:
 def robot_import(args: argparse.Namespace) -> int:
     """Draft and write the joint map of an MJCF robot. A robot that does not stand in the
     drafted posture still gets its joint map written (exit 0): that file is where the user
-    makes it stand. Its summary then says ``"stands": false`` and a ``warning:`` line says
+    makes it stand. An existing ``--out`` is refused unless ``--force`` (its edits would be
+    lost). Its summary then says ``"stands": false`` and a ``warning:`` line says
     what to change; ``robot stand`` and ``learn`` refuse it until it stands."""
     from imitwalk.errors import RobotError
     from imitwalk.fileio import atomic_write, check_writable
@@ -78,6 +79,11 @@ def robot_import(args: argparse.Namespace) -> int:
     out, mjcf = check_writable(args.out, "--out", RobotError), Path(args.mjcf)
     if out.exists() and mjcf.exists() and out.resolve() == mjcf.resolve():
         raise RobotError(f"--out {out} is the MJCF file itself; imitwalk never edits it")
+    if out.exists() and not args.force:  # a joint map is where the user edits: keep it
+        raise RobotError(
+            f"--out {out} exists (a joint map you may have edited); give another --out, "
+            "or --force to replace it"
+        )
     draft = draft_joint_map(mjcf, out)
     stand = stand_test(draft.robot, seconds=CHECK_SECONDS)
     for line in (*draft.lines, stand.line()):

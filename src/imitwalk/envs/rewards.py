@@ -80,7 +80,8 @@ class RewardWeights:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if not isinstance(v, int | float) or not np.isfinite(v) or v < 0:
+            bad = isinstance(v, bool) or not isinstance(v, int | float)
+            if bad or not np.isfinite(v) or v < 0:
                 raise ConfigError(f"reward weight {f.name}={v!r}: must be a finite number ≥ 0")
 
     @classmethod
@@ -99,10 +100,17 @@ class RewardWeights:
     @classmethod
     def from_dict(cls, d: dict) -> RewardWeights:
         """From ``{term: weight}`` (a one-line :class:`ConfigError` naming the terms for
-        an unknown one)."""
-        for k in d:
+        an unknown one, or for a weight that is not a number)."""
+        if not isinstance(d, dict):
+            raise ConfigError(
+                f"reward weights {d!r}: expected a {{term: weight}} dictionary "
+                f"(terms: {', '.join(TERMS)})"
+            )
+        for k, v in d.items():
             if k not in TERMS:
                 raise unknown_name("reward term", str(k), TERMS, ConfigError)
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise ConfigError(f"reward weight {k}={v!r}: must be a finite number ≥ 0")
         return cls(**{k: float(v) for k, v in d.items()})
 
     def to_dict(self) -> dict[str, float]:

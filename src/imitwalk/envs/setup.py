@@ -9,12 +9,12 @@ observation layout. Every choice is checked here, in one line each.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imitwalk.envs.rewards import RewardWeights
+from imitwalk.envs.rewards import TERMS, RewardWeights
 from imitwalk.envs.tracking import TrackingTarget
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.rl.observation import ACTIONS, ObservationLayout
@@ -28,13 +28,15 @@ from imitwalk.step.style import GaitStyle
 if TYPE_CHECKING:
     from imitwalk.mocap import Motion
 
-__all__ = ["BOX", "TRAIN_ROBOTS", "WalkConfig", "WalkSetup", "build_setup"]
+__all__ = ["BOX", "MAX_SECONDS", "TRAIN_ROBOTS", "WalkConfig", "WalkSetup", "build_setup"]
 
 #: The action box's default half-width [rad] by action mode.
 BOX = {"residual": 0.15, "joints": 0.5}
 #: How many training robots an episode draws from (seeds ``TRAIN_FIRST`` on, which no
 #: judge uses).
 TRAIN_ROBOTS = 100_000
+#: The longest episode [s]: one simulated hour (the tracking target holds every tick of it).
+MAX_SECONDS = 3600.0
 
 
 @dataclass(frozen=True)
@@ -46,13 +48,18 @@ class WalkConfig:
         or a joint-map file; protocol: a shipped protocol's name or a protocol file;
         action: one of :data:`~imitwalk.rl.observation.ACTIONS`; run: a stepping run
         folder whose style and learned gains a residual policy adds to (``None``: the
-        clip's style with the gains imitwalk ships); seconds: an episode's length [s];
+        clip's style with the gains imitwalk ships); seconds: an episode's length [s],
+        at most :data:`MAX_SECONDS` (one simulated hour);
         box: the action box's half-width [rad] (``None``: :data:`BOX`'s for the mode),
         around zero (``residual``) or the standing posture (``joints``, as
         humanoid-gym's default pose plus a scaled action); previous_action:
-        observe the last action; weights: the reward's (``None``: the action mode's,
-        :meth:`RewardWeights.for_action`); first_robot, robots: each episode's robot is
-        drawn from protocol seeds ``first_robot … first_robot + robots − 1``.
+        observe the last action (a bool); weights: the reward's, a
+        :class:`RewardWeights` or its ``{term: weight}`` dictionary (``None``: the action
+        mode's, :meth:`RewardWeights.for_action`); first_robot, robots: each episode's
+        robot is drawn from protocol seeds ``first_robot … first_robot + robots − 1``.
+
+    Every value is checked here (a one-line :class:`~imitwalk.errors.ConfigError`); a
+    bool is not taken for a number.
     """
 
     clip: str | None = None
@@ -74,14 +81,28 @@ class WalkConfig:
             v = getattr(self, name)
             if name == "box" and v is None:
                 continue
-            if not isinstance(v, int | float) or not np.isfinite(v) or v <= 0:
+            if not _is_number(v) or not np.isfinite(v) or v <= 0:
                 raise ConfigError(f"{name}={v!r}: must be a finite number > 0")
+        if self.seconds > MAX_SECONDS:
+            raise ConfigError(
+                f"seconds={self.seconds!r}: an episode lasts at most {MAX_SECONDS:g} s "
+                "(one simulated hour)"
+            )
         if self.run is not None and self.clip is not None:
             raise ConfigError("give a clip or a stepping run (whose clip it walks), not both")
-        if not isinstance(self.robots, int) or self.robots < 1:
+        if not _is_whole(self.robots) or self.robots < 1:
             raise ConfigError(f"robots={self.robots!r}: must be a whole number ≥ 1")
-        if not isinstance(self.first_robot, int) or self.first_robot < 0:
+        if not _is_whole(self.first_robot) or self.first_robot < 0:
             raise ConfigError(f"first_robot={self.first_robot!r}: must be a whole number ≥ 0")
+        if not isinstance(self.previous_action, bool):
+            raise ConfigError(f"previous_action={self.previous_action!r}: must be True or False")
+        if isinstance(self.weights, dict):  # as to_dict wrote it
+            object.__setattr__(self, "weights", RewardWeights.from_dict(self.weights))
+        elif self.weights is not None and not isinstance(self.weights, RewardWeights):
+            raise ConfigError(
+                f"weights={self.weights!r}: must be RewardWeights, a {{term: weight}} "
+                f"dictionary (terms: {', '.join(TERMS)}) or None"
+            )
 
     def to_dict(self) -> dict:
         """Plain-JSON dictionary (the keyword arguments of ``gym.make``)."""
@@ -91,16 +112,28 @@ class WalkConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> WalkConfig:
-        """What :meth:`to_dict` wrote."""
-        d = dict(d)
-        if d.get("weights") is not None:
-            d["weights"] = RewardWeights.from_dict(d["weights"])
+        """What :meth:`to_dict` wrote (a one-line :class:`ConfigError` listing the
+        settings for an unknown one)."""
+        valid = [f.name for f in fields(cls)]
+        for k in d:
+            if k not in valid:
+                raise unknown_name("environment setting", str(k), valid, ConfigError)
         return cls(**d)
 
     @property
     def reward_weights(self) -> RewardWeights:
         """The weights in use."""
         return self.weights or RewardWeights.for_action(self.action)
+
+
+def _is_number(v: object) -> bool:
+    """A real number, not a bool (``True`` is no length of time)."""
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def _is_whole(v: object) -> bool:
+    """A whole number, not a bool."""
+    return isinstance(v, int) and not isinstance(v, bool)
 
 
 @dataclass(frozen=True)

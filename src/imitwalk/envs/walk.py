@@ -13,14 +13,19 @@ friction, masses, servos, slope, noise and kicks), walking for ``seconds``:
 - **termination** on a fall (the judge's own test), truncation at ``seconds``.
 
 Seeding is exact: ``reset(seed=s)`` draws the same robot and the same walk. ``reset``'s
-``options={"robot_seed": k}`` walks protocol robot ``k`` itself (the judge's robots are
-0 … 39; training draws from 1001 on). Only the simulator (:mod:`imitwalk.sim`) steps
-the physics.
+``options={"robot_seed": k}`` walks protocol robot ``k`` itself, a whole number ≥ 0 (the
+judge's robots are 0 … 39; training draws from 1001 on). Only the simulator
+(:mod:`imitwalk.sim`) steps the physics.
+
+Bad input is refused in one line (:class:`~imitwalk.errors.ConfigError`): an unknown
+keyword argument, an action that is not a ``(n,)`` array of finite numbers (the action
+space's shape; nothing is broadcast or reshaped), an unknown reset option. A finite
+action outside the box is clipped to it.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
@@ -40,11 +45,42 @@ if TYPE_CHECKING:
 __all__ = ["RENDER_MODES", "WalkEnv"]
 
 RENDER_MODES = ("rgb_array",)
+#: The options :meth:`WalkEnv.reset` takes.
+RESET_OPTIONS = ("robot_seed",)
 
 
 def _heading(quat: np.ndarray) -> float:
     w, x, y, z = (float(v) for v in quat)
     return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+
+
+def _checked_action(action: Any, n: int) -> np.ndarray:
+    """``action`` as a ``(n,)`` float array [rad], or a one-line :class:`ConfigError`."""
+    want = f"expected a ({n},) array of finite numbers [rad], the action space's shape"
+    a = np.asarray(action)
+    if a.dtype.kind not in "iuf":
+        raise ConfigError(f"action {_short(action)}: not numbers; {want}")
+    if a.shape != (n,):
+        raise ConfigError(f"action of shape {a.shape}: {want}")
+    a = a.astype(float)
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        i = int(bad[0])
+        raise ConfigError(f"action[{i}] = {a[i]}: not finite ({bad.size} of {n}); {want}")
+    return a
+
+
+def _short(x: Any) -> str:
+    """``repr(x)`` on one line, cut to 40 characters."""
+    text = " ".join(repr(x).split())
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _robot_seed(v: Any) -> int:
+    """``reset``'s ``robot_seed`` option: a whole number ≥ 0 (not a bool or a float)."""
+    if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
+        raise ConfigError(f"robot_seed={_short(v)}: must be a whole number ≥ 0")
+    return int(v)
 
 
 class WalkEnv(gym.Env):
@@ -63,7 +99,15 @@ class WalkEnv(gym.Env):
     ):
         if render_mode is not None and render_mode not in RENDER_MODES:
             raise unknown_name("render mode", str(render_mode), RENDER_MODES, ConfigError)
-        self.setup = setup if setup is not None else build_setup(WalkConfig(**config))
+        valid = (*(f.name for f in fields(WalkConfig)), "render_mode", "setup")
+        for name in config:
+            if name not in valid:
+                raise unknown_name("keyword argument", str(name), valid, ConfigError)
+        if setup is not None and config:
+            raise ConfigError(
+                f"give a built setup or the settings ({', '.join(sorted(config))}), not both"
+            )
+        self.setup = setup if setup is not None else build_setup(WalkConfig.from_dict(config))
         self.render_mode = render_mode
         s = self.setup
         self.action_space = gym.spaces.Box(
@@ -79,11 +123,17 @@ class WalkEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        options = options or {}
+        if not isinstance(options, dict):
+            raise ConfigError(f"options={_short(options)}: expected a dictionary or None")
+        for name in options:  # checked before anything changes
+            if name not in RESET_OPTIONS:
+                raise unknown_name("reset option", str(name), RESET_OPTIONS, ConfigError)
+        chosen = _robot_seed(options["robot_seed"]) if "robot_seed" in options else None
         super().reset(seed=seed)
         s, cfg = self.setup, self.setup.config
-        options = options or {}
-        if "robot_seed" in options:
-            robot_seed = int(options["robot_seed"])
+        if chosen is not None:
+            robot_seed = chosen
         else:
             robot_seed = cfg.first_robot + int(self.np_random.integers(cfg.robots))
         draw = s.protocol.draw(robot_seed, s.robot, seconds=cfg.seconds)
@@ -108,10 +158,16 @@ class WalkEnv(gym.Env):
         return self._observe(obs), {"robot_seed": robot_seed}
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """One control tick with ``action``: ``(n,)`` joint targets or offsets [rad] (the
+        action space's shape), finite; clipped to the box.
+
+        Raises:
+            ConfigError: an action of another shape, not numbers, or not finite.
+        """
         if self.plant is None:
             raise gym.error.ResetNeeded("call reset() before step()")
         s, cfg = self.setup, self.setup.config
-        a = np.clip(np.asarray(action, dtype=float).reshape(-1), s.low, s.high)
+        a = np.clip(_checked_action(action, len(s.low)), s.low, s.high)
         targets = a + self.base if self.base is not None else a
         self.plant.command(targets)
         obs = self.plant.step()

@@ -212,9 +212,10 @@ def _gains(rd: RunDir, names: tuple[str, ...], what: str) -> dict:
 
     Raises:
         RunError: one line naming the file and the entry missing or invalid, and the
-            entries such a run's gains.json holds.
+            entries such a run's gains.json holds; or an entry that lacks gains (learning
+            writes every one: a gain missing is not taken from the defaults), listing them.
     """
-    from imitwalk.step.gains import StepGains
+    from imitwalk.step.gains import BOUNDS, StepGains
 
     path, saved = rd.file("gains.json"), rd.read_json("gains.json")
     holds = " and ".join(repr(n) for n in names)
@@ -230,6 +231,12 @@ def _gains(rd: RunDir, names: tuple[str, ...], what: str) -> dict:
             out[name] = StepGains.from_dict(saved[name])
         except ConfigError as exc:
             raise RunError(f"{path}: {name!r}: {exc}") from None
+        lacks = [g for g in BOUNDS if g not in saved[name]]
+        if lacks:
+            raise RunError(
+                f"{path}: {name!r} lacks the gains {', '.join(lacks)} (a run's gains.json "
+                "holds every one; learn the run again)"
+            )
     return out
 
 

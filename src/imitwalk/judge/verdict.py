@@ -42,6 +42,7 @@ from imitwalk.sim.types import SimOptions
 __all__ = [
     "JudgeJob",
     "Judged",
+    "JudgedRobot",
     "RobotWalk",
     "RunController",
     "judge_controllers",
@@ -58,6 +59,22 @@ class Judged(Interface):
     def walk(
         self, robot: Robot, options: SimOptions, seconds: float, engine: str
     ) -> WalkMetrics: ...
+
+
+@dataclass(frozen=True)
+class JudgedRobot:
+    """The robot a verdict was judged on, as ``imitwalk evaluate`` records it beside the
+    verdict (``"robot"`` in ``protocol_NAME.json`` and ``push_recovery.json``).
+
+    Attributes:
+        name: the robot's name (:attr:`~imitwalk.robots.Robot.name`); robot: as the
+        command named it, a built-in name or its file's absolute path; joint_map: the
+        joint map given beside an MJCF, as an absolute path (``None``: none).
+    """
+
+    name: str
+    robot: str
+    joint_map: str | None = None
 
 
 @dataclass(frozen=True)
@@ -204,7 +221,13 @@ def judge_protocol(
     """Every controller in ``controllers`` that the run at ``run_dir`` builds (``None``:
     every one it can) judged by :func:`judge_controllers`, at the stride ``scale``
     (``None``: the one the run reached); a controller that is an exact copy of another
-    (:meth:`~imitwalk.judge.replay.LoadedRun.twin`) is walked once."""
+    (:meth:`~imitwalk.judge.replay.LoadedRun.twin`) is walked once.
+
+    Raises:
+        ConfigError: ``seeds`` under 1 or ``first`` under 0 (before the run is read), or a
+            controller the run cannot build.
+    """
+    _check_robots(seeds, first)
     loaded = _loaded(str(run_dir))
     names = _checked_controllers(loaded, controllers)
     twins = {c: loaded.twin(c) for c in names}
@@ -238,9 +261,12 @@ def judge_controllers(
     on). ``most_falls`` (one controller only): stop once more robots than that fell; the
     verdict is then on the robots walked, in seed order (fewer than ``seeds``).
     ``twins``: name → the name of the controller walked in its place (an exact copy; by
-    default each walks itself)."""
-    if first < 0:
-        raise ConfigError(f"first robot {first}: valid robots are 0 and up")
+    default each walks itself).
+
+    Raises:
+        ConfigError: ``seeds`` under 1 (or not a whole number) or ``first`` under 0.
+    """
+    _check_robots(seeds, first)
     twin = dict(twins) if twins is not None else {c: c for c in controllers}
     names = tuple(twin)
     draws = [protocol.draw(first + s, robot, seconds=seconds) for s in range(seeds)]
@@ -267,6 +293,15 @@ def judge_controllers(
         controllers={c: _side(runs, protocol.factors, saved[c]) for c, runs in by.items()},
         comparison=_comparison(by, names),
     )
+
+
+def _check_robots(seeds: object, first: int) -> None:
+    """Refuse a count of robots to judge that is not a whole number >= 1, or a first robot
+    under 0."""
+    if isinstance(seeds, bool) or not isinstance(seeds, int | np.integer) or seeds < 1:
+        raise ConfigError(f"seeds {seeds!r}: expected a whole number of robots >= 1")
+    if first < 0:
+        raise ConfigError(f"first robot {first}: valid robots are 0 and up")
 
 
 def _checked_controllers(loaded: LoadedRun, controllers: tuple[str, ...] | None) -> tuple[str, ...]:

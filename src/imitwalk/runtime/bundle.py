@@ -20,13 +20,15 @@ code (:class:`~imitwalk.runtime.controller.Controller`). :func:`write_bundle` wr
 folder atomically (a reader sees the old export or the new one, never part of one; an
 earlier export being replaced is absent for the instant between two renames);
 :func:`read_bundle` refuses one that was tampered with, truncated, or written for
-another format, in one line.
+another format, in one line (the manifest's fields: :mod:`imitwalk.runtime.manifest`).
+:func:`write_bundle` replaces only an earlier export, and never through a symbolic link
+(:func:`check_out`): a folder holding anything else is refused and left as it was.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
+import numbers
 import os
 import shutil
 import tempfile
@@ -37,8 +39,21 @@ from typing import TYPE_CHECKING, Any
 from imitwalk import readback
 from imitwalk.errors import ConfigError, ImitwalkError, RunError, unknown_name
 from imitwalk.robots import Robot
-from imitwalk.robots.saved import MUJOCO_VERSION, ROBOT_FILES, load_saved_robot, save_robot
-from imitwalk.runtime.sensors import BLOCKS, SensorLayout
+from imitwalk.robots.saved import load_saved_robot, save_robot
+from imitwalk.runtime.manifest import (
+    BUNDLE_FORMAT,
+    DT_RANGE,
+    KINDS,
+    MANIFEST,
+    PARTS,
+    build_manifest,
+    check_robot,
+    is_export,
+    not_export,
+    read_manifest,
+    sha256,
+)
+from imitwalk.runtime.sensors import SensorLayout
 from imitwalk.step.gains import StepGains
 from imitwalk.step.style import GaitStyle
 
@@ -51,33 +66,12 @@ __all__ = [
     "KINDS",
     "MANIFEST",
     "Bundle",
+    "check_out",
     "is_export",
     "read_bundle",
     "read_manifest",
     "write_bundle",
 ]
-
-#: The format version of an export written here (and the newest read). 2: the stepping
-#: gait's style carries its ``stride_share`` (a format-1 style walks its whole stride).
-BUNDLE_FORMAT = 2
-#: The manifest's file name, and the value of its ``"kind"`` key.
-MANIFEST, KIND = "manifest.json", "imitwalk controller"
-#: The controllers an export holds: the stepping gait, or a PPO policy (on the stepping
-#: gait, or joint targets from scratch).
-KINDS = ("stepping", "rl-residual", "rl-joints")
-
-#: The sensor blocks' frames and meanings, as the manifest states them.
-_FRAMES = {
-    "gyro": "the IMU site's frame (the robot's gyro sensor)",
-    "accel": "the IMU site's frame; specific force, +9.81 up when still",
-    "foot_force": "normal force of each sole sensor, left sole first, in the order listed",
-    "joints": "encoder angle x the joint's sign, in the joint order",
-}
-_PARTS = {
-    "stepping": ("style.json", "gains.json"),
-    "rl-residual": ("style.json", "gains.json", "actor.json", "policy.npz"),
-    "rl-joints": ("actor.json", "policy.npz"),
-}
 
 
 @dataclass(frozen=True)
@@ -86,9 +80,10 @@ class Bundle:
 
     Attributes:
         kind: one of :data:`KINDS`; robot: the nominal robot; dt: the control period
-        [s]; style: the stepping gait's style (at the scale exported), ``None`` for a
-        policy from scratch; gains: its gains; actor: a PPO policy's spec and network;
-        source: where it came from (the run's folder, learner, controller and scale).
+        [s], within :data:`~imitwalk.runtime.manifest.DT_RANGE`; style: the stepping
+        gait's style (at the scale exported), ``None`` for a policy from scratch; gains:
+        its gains; actor: a PPO policy's spec and network; source: where it came from
+        (the run's folder, learner, controller and scale).
     """
 
     kind: str
@@ -104,71 +99,17 @@ class Bundle:
             raise unknown_name("controller kind", self.kind, KINDS, ConfigError)
         stepping, policy = self.style is not None, self.actor is not None
         if (stepping != (self.kind != "rl-joints")) or (policy != self.kind.startswith("rl")):
-            raise ConfigError(f"a {self.kind!r} controller needs {', '.join(_PARTS[self.kind])}")
+            raise ConfigError(f"a {self.kind!r} controller needs {', '.join(PARTS[self.kind])}")
         if stepping and self.gains is None:
             raise ConfigError("a stepping gait needs its gains")
+        lo, hi = DT_RANGE
+        if not (isinstance(self.dt, numbers.Real) and lo < self.dt <= hi):  # NaN fails too
+            raise ConfigError(f"dt must be the control period [s], {lo:g} < dt <= {hi:g}")
 
     @property
     def sensors(self) -> SensorLayout:
         """The sensor vector this controller reads."""
         return SensorLayout(len(self.robot.foot_force["l"]), self.robot.dof)
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with path.open("rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
-def _manifest(b: Bundle, files: dict[str, str]) -> dict[str, Any]:
-    r, lay = b.robot, b.sensors
-    blocks = []
-    for name, unit in BLOCKS:
-        block: dict[str, Any] = {"name": name, "size": lay.sizes[name], "unit": unit}
-        block["frame"] = _FRAMES[name]
-        if name == "gyro":
-            block["mjcf_sensor"] = r.gyro
-        elif name == "accel":
-            block["mjcf_sensor"] = r.accelerometer
-        elif name == "foot_force":
-            block["mjcf_sensors"] = [*r.foot_force["l"], *r.foot_force["r"]]
-        blocks.append(block)
-    joints = [
-        {
-            "name": n,
-            "mjcf_joint": mj,
-            "sign": int(s),
-            "unit": "rad",
-            "stand": float(q0),
-            "range": [float(lo), float(hi)],
-        }
-        for n, mj, s, q0, (lo, hi) in zip(
-            r.joint_names, r.mj_joints, r.signs, r.stand, r.limits, strict=True
-        )
-    ]
-    from imitwalk import __version__
-
-    return {
-        readback.FORMAT_KEY: BUNDLE_FORMAT,
-        "kind": KIND,
-        "controller": b.kind,
-        "versions": {"imitwalk": __version__, "mujoco": MUJOCO_VERSION},
-        "source": b.source,
-        "robot": r.name,
-        "control": {"rate_hz": 1.0 / b.dt, "dt_s": b.dt},
-        "joints": joints,
-        "sensors": {"size": lay.size, "blocks": blocks},
-        "output": {
-            "name": "joint targets",
-            "size": r.dof,
-            "unit": "rad",
-            "order": "the joints, with their signs",
-            "to": "position servos",
-        },
-        "files": files,
-    }
 
 
 def _write_parts(b: Bundle, folder: Path) -> None:
@@ -183,29 +124,58 @@ def _write_parts(b: Bundle, folder: Path) -> None:
         net.save(folder / "policy.npz")
 
 
-def is_export(folder: Path) -> bool:
-    """True if ``folder`` holds an export's manifest."""
-    return (Path(folder) / MANIFEST).is_file()
+def check_out(folder: str | Path) -> Path:
+    """``folder`` as a place :func:`write_bundle` may write an export: missing, an empty
+    folder, or an earlier export (:func:`~imitwalk.runtime.manifest.is_export`: its
+    manifest of kind ``"imitwalk controller"``, and nothing in it but the files that
+    manifest lists). Nothing is deleted here.
+
+    Raises:
+        ConfigError: one line: ``folder`` is ``""``, ``.`` or ``..``, a symbolic link
+            (write to a new folder and point the link at it), a file, or a folder that
+            holds anything else.
+    """
+    if Path(folder).name in ("", ".."):  # "", ".", "..": it would rename the folder it is in
+        raise ConfigError(
+            f"--out {str(folder)!r} names no folder of its own; give the export folder's name"
+        )
+    folder = Path(folder)
+    if folder.is_symlink():
+        raise ConfigError(
+            f"--out {folder} is a symbolic link (to {os.readlink(folder)}); give a new folder "
+            "and point the link at it, or the link's target itself"
+        )
+    if folder.exists() and not folder.is_dir():
+        raise ConfigError(f"--out {folder} is a file, not an export folder; give a folder")
+    if folder.is_dir() and any(folder.iterdir()):
+        why = not_export(folder)
+        if why is not None:
+            raise ConfigError(
+                f"--out {folder} is not an export ({why}); nothing was replaced: give a new "
+                "folder, an empty one, or an earlier export"
+            )
+    return folder
 
 
 def write_bundle(b: Bundle, folder: str | Path) -> Path:
     """Write ``b`` to ``folder`` atomically: into a new folder beside it, then renamed
-    over it. ``folder`` may be missing, empty, or an earlier export (replaced).
+    over it. ``folder`` may be missing, empty, or an earlier export (replaced); anything
+    else is refused before anything is written (:func:`check_out`).
 
     Raises:
-        ConfigError: ``folder`` is a file, or a folder that holds something else.
+        ConfigError: ``folder`` is a symbolic link, a file, or a folder that holds
+            something other than an export.
     """
-    folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise ConfigError(f"--out {folder} is a file; give a folder for the export")
-    if folder.is_dir() and any(folder.iterdir()) and not is_export(folder):
-        raise ConfigError(f"--out {folder} holds files that are not an export; give a new folder")
+    folder = check_out(folder)
     folder.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".tmp", dir=folder.parent))
     try:
         _write_parts(b, tmp)
-        files = {p.name: _sha256(p) for p in sorted(tmp.iterdir())}
-        (tmp / MANIFEST).write_text(json.dumps(_manifest(b, files), indent=1) + "\n")
+        files = {p.name: sha256(p) for p in sorted(tmp.iterdir())}
+        (tmp / MANIFEST).write_text(
+            json.dumps(build_manifest(b.robot, b.sensors, b.kind, b.source, b.dt, files), indent=1)
+            + "\n"
+        )
         os.chmod(tmp, 0o755)
         old = None
         if folder.exists():
@@ -220,50 +190,13 @@ def write_bundle(b: Bundle, folder: str | Path) -> Path:
     return folder
 
 
-def read_manifest(folder: str | Path) -> dict[str, Any]:
-    """An export's manifest, checked: its kind, format and the files it lists (each
-    present, with the SHA-256 recorded).
-
-    Raises:
-        RunError: one line naming what is wrong (not an export, another format, a file
-            missing, changed or truncated).
-    """
-    folder = Path(folder)
-    path = folder / MANIFEST
-    what = "an exported controller's manifest (from 'imitwalk export')"
-    if not folder.is_dir():
-        raise RunError(f"{folder} is not a folder: give the folder 'imitwalk export' wrote")
-    req = ("kind", "controller", "control", "joints", "sensors", "files")
-    m = readback.read_json(path, what, RunError, required=req)
-    if m["kind"] != KIND:
-        raise RunError(f"{path} is not {what}: its kind is {m['kind']!r}")
-    if readback.FORMAT_KEY not in m:
-        raise RunError(f"{path} has no {readback.FORMAT_KEY!r}: not {what}")
-    readback.check_format(m, BUNDLE_FORMAT, str(path), RunError)
-    kind = m["controller"]
-    if kind not in KINDS:
-        raise RunError(f"{path}: controller {kind!r} is not one of {', '.join(KINDS)}")
-    files = m["files"]
-    need = (*ROBOT_FILES, *_PARTS[kind])
-    if not isinstance(files, dict) or sorted(files) != sorted(need):
-        raise RunError(f"{path}: a {kind!r} export lists the files {', '.join(need)}")
-    for name in need:
-        p = folder / name
-        if not p.is_file():
-            raise RunError(f"{folder}: {name} is missing; export the run again")
-        if _sha256(p) != files[name]:
-            raise RunError(
-                f"{p} differs from what the manifest recorded (changed or truncated); "
-                "export the run again"
-            )
-    return m
-
-
 def read_bundle(folder: str | Path) -> Bundle:
-    """The controller exported to ``folder`` (checked by :func:`read_manifest`).
+    """The controller exported to ``folder`` (checked by :func:`read_manifest`, its
+    manifest held to its ``robot.json`` by :func:`~imitwalk.runtime.manifest.check_robot`).
 
     Raises:
-        RunError: the folder is not a complete, unchanged export of this format.
+        RunError: the folder is not a complete, unchanged export of this format, or its
+            manifest says something its files do not.
     """
     folder = Path(folder)
     m = read_manifest(folder)
@@ -273,10 +206,10 @@ def read_bundle(folder: str | Path) -> Bundle:
         robot = load_saved_robot(folder)
         dt = float(m["control"]["dt_s"])
         style = gains = actor = None
-        if "style.json" in _PARTS[kind]:
+        if "style.json" in PARTS[kind]:
             style = GaitStyle.from_dict(read("style.json", "a gait style"))
             gains = StepGains.from_dict(read("gains.json", "a stepping gait's gains"))
-        if "actor.json" in _PARTS[kind]:
+        if "actor.json" in PARTS[kind]:
             from imitwalk.rl.actor import ActorSpec
             from imitwalk.rl.network import MLP
 
@@ -286,7 +219,5 @@ def read_bundle(folder: str | Path) -> Bundle:
         raise
     except (ImitwalkError, KeyError, TypeError, ValueError) as exc:
         raise RunError(f"{folder} is not a usable export: {type(exc).__name__}: {exc}") from None
-    names = [j.get("name") for j in m["joints"]] if isinstance(m["joints"], list) else None
-    if names != list(robot.joint_names) or m["sensors"].get("size") != b.sensors.size:
-        raise RunError(f"{folder / MANIFEST}: its joints or sensors disagree with robot.json")
+    check_robot(m, robot, folder / MANIFEST)
     return b

@@ -8,7 +8,16 @@
     q = ctl.reset(read_sensors())              # the robot standing: the first tick
     while walking:                             # every ctl.dt seconds (ctl.rate_hz)
         send_joint_targets(q)                  # (n,) [rad], ctl.joint_names order and signs
-        q = ctl.step(read_sensors())           # (6 + 2k + n,), see imitwalk.runtime.sensors
+        try:
+            q = ctl.step(read_sensors())       # (6 + 2k + n,), see imitwalk.runtime.sensors
+        except SensorError:
+            pass                               # refused: q is held, the tick not counted
+
+Every target is within its joint's range (the manifest's ``range``, ``ctl.limits``): the
+controller clamps its output to it, as the simulator's position servos clamp their
+control. A reading :meth:`Controller.step` refuses changes nothing: the tick is not
+counted and the controller's state is as before, so the robot should hold the last
+targets it was sent and, if readings stay refused, stop by its own safe stop.
 
 :class:`Controller` plays the same objects the judge plays (the stepping gait's
 :class:`~imitwalk.step.controller.SteppingController`, a PPO run's
@@ -65,7 +74,8 @@ class Controller:
         bundle: that; sensors: the :class:`~imitwalk.runtime.sensors.SensorLayout` it
         reads; joint_names: the ``n`` joints of its output, in order; dt: the control
         period [s]; rate_hz: ``1 / dt``; q0: ``(n,)`` the standing posture [rad] the
-        robot should hold before :meth:`reset`.
+        robot should hold before :meth:`reset`; limits: ``(n, 2)`` each joint's range
+        ``[lo, hi]`` [rad] (the manifest's ``range``), to which every target is clamped.
     """
 
     def __init__(self, bundle: Bundle):
@@ -76,6 +86,7 @@ class Controller:
         self.rate_hz = 1.0 / bundle.dt
         self._policy = _policy(bundle)
         self.q0 = np.asarray(self._policy.q0, dtype=float).copy()
+        self.limits = np.asarray(bundle.robot.limits, dtype=float).copy()  # (n, 2)
         self._tick: int | None = None
 
     @classmethod
@@ -89,31 +100,38 @@ class Controller:
 
     def reset(self, sensors: npt.ArrayLike) -> np.ndarray:
         """Start a walk from the robot standing: its readings now ``(6 + 2k + n,)``. Returns
-        the joint targets of this first tick ``(n,)`` [rad].
+        the joint targets of this first tick ``(n,)`` [rad], each within its joint's range.
 
         Raises:
-            SensorError: a vector of the wrong length, or with a value not finite.
+            SensorError: a reading :meth:`step` refuses; the controller is then as before
+                (a walk under way goes on at the next :meth:`step`; before the first
+                reset, :meth:`step` is still refused).
         """
-        self._tick = 0
-        return self._decide(sensors)
+        return self._decide(sensors, 0)
 
     def step(self, sensors: npt.ArrayLike) -> np.ndarray:
         """One control tick: the readings now ``(6 + 2k + n,)`` → joint targets ``(n,)``
-        [rad], to be sent to the position servos until the next tick.
+        [rad], each clamped to its joint's range (:attr:`limits`), to be sent to the
+        position servos until the next tick.
 
         Raises:
-            SensorError: a vector of the wrong length, or with a value not finite; or no
-                :meth:`reset` before.
+            SensorError: a vector of the wrong length, an entry not a real number (bool,
+                complex, text, other objects), not finite, or beyond
+                :data:`~imitwalk.runtime.sensors.MAX_READING`; or no :meth:`reset` before.
+                A refused reading is not counted as a tick and leaves the controller as
+                it was: hold the last targets sent.
         """
         if self._tick is None:
             raise SensorError("call reset(sensors) with the robot standing before step(sensors)")
-        self._tick += 1
-        return self._decide(sensors)
+        return self._decide(sensors, self._tick + 1)
 
-    def _decide(self, sensors: npt.ArrayLike) -> np.ndarray:
-        assert self._tick is not None
-        obs = self.sensors.observation(sensors, self._tick * self.dt)
-        return np.asarray(self._policy(self._tick, obs), dtype=float)
+    def _decide(self, sensors: npt.ArrayLike, tick: int) -> np.ndarray:
+        """Tick ``tick``'s targets ``(n,)`` [rad]; the tick counts only once the readings
+        are taken."""
+        obs = self.sensors.observation(sensors, tick * self.dt)
+        self._tick = tick
+        q = np.asarray(self._policy(tick, obs), dtype=float)
+        return np.clip(q, self.limits[:, 0], self.limits[:, 1])
 
     def as_policy(self) -> _AsPolicy:
         """This controller as a policy ``(tick, observation) -> targets`` for

@@ -15,9 +15,11 @@ block           size        unit    meaning
                                     signs (``sign × the MJCF joint's angle``)
 ==============  ==========  ======  ========================================================
 
-:meth:`SensorLayout.observation` checks a vector (its length, every entry finite) and
-turns it into the :class:`~imitwalk.sim.types.Observation` record every imitwalk
-controller reads; :meth:`SensorLayout.vector` is its inverse.
+:meth:`SensorLayout.observation` checks a vector (its length; every entry a real number,
+int or float, not a bool, complex number, text or other object; finite; and within
+:data:`MAX_READING` in size) and turns it into the
+:class:`~imitwalk.sim.types.Observation` record every imitwalk controller reads;
+:meth:`SensorLayout.vector` is its inverse.
 """
 
 from __future__ import annotations
@@ -31,10 +33,17 @@ import numpy.typing as npt
 from imitwalk.errors import SensorError
 from imitwalk.sim.types import Observation
 
-__all__ = ["BLOCKS", "SensorLayout"]
+__all__ = ["BLOCKS", "MAX_READING", "SensorLayout"]
 
 #: The blocks of the sensor vector, in order, with their units.
 BLOCKS = (("gyro", "rad/s"), ("accel", "m/s^2"), ("foot_force", "N"), ("joints", "rad"))
+#: The largest reading taken, in any block's unit (rad/s, m/s², N, rad): 1e6 is beyond any
+#: sensor of a walking robot (a gyro saturates near 35 rad/s, an IMU's accelerometer near
+#: 2000 m/s², a sole sensor near 1e4 N), and keeps every sum and square inside the
+#: controller finite (a reading near 1e308 would overflow). A larger one is a fault.
+MAX_READING = 1e6
+#: The NumPy kinds of an array taken as numbers: float, signed and unsigned int.
+_NUMBER_KINDS = "fiu"
 
 
 @dataclass(frozen=True)
@@ -75,21 +84,21 @@ class SensorLayout:
         """The readings ``sensors`` ``(6 + 2k + n,)`` as an observation at time ``t`` [s].
 
         Raises:
-            SensorError: the vector is not 1-D of :attr:`size` numbers, or one is not
-                finite (the message names the blocks and the entries at fault).
+            SensorError: the vector is not 1-D of :attr:`size` entries, an entry is not a
+                real number (a bool, complex number, text, ``None`` or other object), or
+                one is not finite or beyond :data:`MAX_READING` in size (the message
+                names the blocks and the entries at fault).
         """
-        try:
-            v = np.asarray(sensors, dtype=float)
-        except (TypeError, ValueError):
-            got = type(sensors).__name__
-            raise SensorError(f"sensors must be {self._expected()}; got {got}") from None
-        if v.shape != (self.size,):
-            raise SensorError(f"sensors must be {self._expected()}; got shape {v.shape}")
+        v = self._numbers(sensors)
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
-            where = ", ".join(self._name_of(int(i)) for i in bad[:4])
-            verb = "is" if bad.size == 1 else "are"
-            raise SensorError(f"sensors must be finite; {where} {verb} not")
+            raise SensorError(f"sensors must be finite; {self._entries(bad)} not")
+        bad = np.flatnonzero(np.abs(v) > MAX_READING)
+        if bad.size:
+            raise SensorError(
+                f"sensors must be within +-{MAX_READING:g} (a larger reading is a sensor "
+                f"fault); {self._entries(bad)} not"
+            )
         s = self._slices
         return Observation(
             t=float(t),
@@ -98,6 +107,37 @@ class SensorLayout:
             foot_force=v[s["foot_force"]].reshape(2, self.sole_sensors).copy(),
             joints=v[s["joints"]].copy(),
         )
+
+    def _numbers(self, sensors: npt.ArrayLike) -> np.ndarray:
+        """``sensors`` as a ``(size,)`` float array, if it is one of real numbers."""
+        as_objects = isinstance(sensors, list | tuple)  # [0.1, True] would become floats
+        try:
+            raw = np.asarray(sensors, dtype=object if as_objects else None)
+        except (TypeError, ValueError):
+            raw = np.asarray(None, dtype=object)
+        if raw.ndim == 0:
+            got = type(sensors).__name__
+            raise SensorError(f"sensors must be {self._expected()}; got {got}")
+        if raw.shape != (self.size,):
+            raise SensorError(f"sensors must be {self._expected()}; got shape {raw.shape}")
+        if raw.dtype.kind in _NUMBER_KINDS:
+            return raw.astype(float, copy=False)
+        if raw.dtype.kind == "O":
+            number = (int, float, np.integer, np.floating)
+            odd = [i for i, x in enumerate(raw) if isinstance(x, bool) or not isinstance(x, number)]
+        else:  # bool, complex, text, bytes, dates: every entry
+            odd = list(range(self.size))
+        if odd:
+            kinds = sorted({type(raw[i]).__name__ for i in odd})
+            raise SensorError(
+                f"sensors must be real numbers (int or float); {self._entries(np.array(odd))} "
+                f"not (a {' or '.join(kinds)})"
+            )
+        try:
+            return raw.astype(float)
+        except OverflowError:  # an int beyond any float: refused as beyond MAX_READING
+            big = 2 * MAX_READING
+            return np.array([x if abs(x) <= MAX_READING else big for x in raw], dtype=float)
 
     def vector(self, obs: Observation) -> np.ndarray:
         """``(6 + 2k + n,)`` the vector of an observation (the inverse of
@@ -114,6 +154,12 @@ class SensorLayout:
     def _expected(self) -> str:
         parts = " + ".join(f"{n} {name}" for name, n in self.sizes.items())
         return f"a vector of {self.size} numbers ({parts})"
+
+    def _entries(self, bad: np.ndarray) -> str:
+        """The first few entries of indices ``bad``, named, with ``is`` or ``are``."""
+        where = ", ".join(self._name_of(int(i)) for i in bad[:4])
+        more = f" and {bad.size - 4} more" if bad.size > 4 else ""
+        return f"{where}{more} {'is' if bad.size == 1 else 'are'}"
 
     def _name_of(self, i: int) -> str:
         for name, sl in self.slices().items():

@@ -204,9 +204,15 @@ class BulletPlant:
 
     # -- Plant interface ------------------------------------------------------
     def reset(self, q: np.ndarray | None = None) -> Observation:
+        """Stand the robot in posture ``q``: ``(n,)`` finite joint angles [rad] in the
+        order of :attr:`joint_names` (``None``: standing), and hold it.
+
+        Raises:
+            ConfigError: ``q`` of another length (e.g. another robot's), or not finite.
+        """
         c, r, opt = self.client, self.robot, self.options
         qpos = self._stand_qpos.copy()
-        q = r.stand if q is None else np.asarray(q, dtype=float)
+        q = r.stand if q is None else checked_targets(q, self.joint_names, r.name, "posture")
         qpos[self._qadr] = q * self._sign
         orn = [*qpos[4:7], qpos[3]]  # (x, y, z, w)
         self._place_base([0.0, 0.0, 0.0], orn)
@@ -232,7 +238,13 @@ class BulletPlant:
         return self.observe()
 
     def command(self, targets: np.ndarray) -> None:
-        self._cmd = self.robot.clip(checked_targets(targets, len(self.joint_names)))
+        """Set ``(n,)`` joint targets [rad] for the next control period, clipped to the
+        joint ranges.
+
+        Raises:
+            ConfigError: targets of another length, or not finite.
+        """
+        self._cmd = self.robot.clip(checked_targets(targets, self.joint_names, self.robot.name))
 
     def step(self) -> Observation:
         c, opt = self.client, self.options

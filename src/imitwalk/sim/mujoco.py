@@ -64,7 +64,7 @@ class Plant(Protocol):
         ...
 
     def command(self, targets: np.ndarray) -> None:
-        """Set ``(n,)`` joint targets [rad] for the next control period."""
+        """Set ``(n,)`` finite joint targets [rad] for the next control period."""
         ...
 
     def step(self) -> Observation:
@@ -125,13 +125,20 @@ class MujocoPlant:
 
     # -- Plant interface ------------------------------------------------------
     def reset(self, q: np.ndarray | None = None) -> Observation:
+        """Stand the robot in posture ``q``: ``(n,)`` finite joint angles [rad] in the
+        order of :attr:`joint_names` (``None``: standing), and hold it.
+
+        Raises:
+            ConfigError: ``q`` of another length (e.g. another robot's), or not finite.
+        """
+        if q is not None:
+            q = checked_targets(q, self.joint_names, self.robot.name, "posture")
         m, d, r = self.model, self.data, self.robot
         mujoco.mj_resetData(m, d)
         if r.stand_ctrl is not None:  # servos of joints without a role hold the posture
             d.ctrl[:] = r.stand_ctrl
         d.qpos[:] = r.stand_qpos
         if q is not None:
-            q = np.asarray(q, dtype=float)
             d.qpos[self._qadr] = q * self._sign
             mujoco.mj_kinematics(m, d)
             low = min(self._sole_z(s) for s in ("l", "r"))
@@ -146,7 +153,14 @@ class MujocoPlant:
         return self.observe()
 
     def command(self, targets: np.ndarray) -> None:
-        self._cmd = self.robot.clip(checked_targets(targets, len(self.joint_names)))
+        """Set ``(n,)`` joint targets [rad] for the next control period, clipped to the
+        joint ranges.
+
+        Raises:
+            ConfigError: targets of another length, or not finite (MuJoCo would zero a
+                NaN control silently, driving its joint to 0 rad).
+        """
+        self._cmd = self.robot.clip(checked_targets(targets, self.joint_names, self.robot.name))
 
     def step(self) -> Observation:
         m, d, opt = self.model, self.data, self.options

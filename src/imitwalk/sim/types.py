@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from imitwalk.errors import ConfigError
+
 __all__ = [
     "ENGINES",
     "Observation",
@@ -131,16 +133,31 @@ def gravity(opt: SimOptions) -> np.ndarray:
     return -9.81 * normal / np.linalg.norm(normal)
 
 
-def checked_targets(targets: np.ndarray, n: int) -> np.ndarray:
-    """``targets`` as a ``(n,)`` float array of joint targets [rad].
+def checked_targets(
+    targets: object, joint_names: tuple[str, ...], robot: str, what: str = "joint targets"
+) -> np.ndarray:
+    """``targets`` as ``(n,)`` finite joint angles [rad], one per name of ``joint_names``
+    (of the robot named ``robot``; ``what``: what they are, for the message).
 
     Raises:
-        ValueError: any other shape.
+        ConfigError: not numbers, another shape (e.g. another robot's), or not finite
+            (MuJoCo would silently zero a NaN control, driving its joint to 0 rad).
     """
-    targets = np.asarray(targets, dtype=float)
-    if targets.shape != (n,):
-        raise ValueError(f"expected {n} joint targets, got {targets.shape}")
-    return targets
+    n = len(joint_names)
+    want = f"expected {n} finite numbers [rad], one per joint of {robot!r}"
+    try:
+        a = np.asarray(targets, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{what}: not numbers; {want}") from None
+    if a.shape != (n,):
+        raise ConfigError(f"{what} of shape {a.shape}: {want}")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        i = int(bad[0])
+        raise ConfigError(
+            f"{what}: {joint_names[i]} is {a[i]} ({bad.size} of {n} not finite); {want}"
+        )
+    return a
 
 
 def jitter_draws(

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imitwalk.errors import ConfigError
 from imitwalk.robots import Robot
 from imitwalk.sim.types import Observation
 from imitwalk.step.estimator import BodyEstimate, BodyEstimator, ObserverNoise
@@ -111,6 +112,11 @@ class SteppingController:
     def __init__(
         self, robot: Robot, style: GaitStyle, gains: StepGains, dt: float, log: bool = False
     ):
+        if not isinstance(style, GaitStyle):
+            raise ConfigError(
+                "style must be a GaitStyle (the .style of a StepGait, as "
+                f"imitwalk.gait_from_motion returns), not {type(style).__name__}"
+            )
         self.robot, self.style, self.gains, self.dt = robot, style, gains, dt
         self.q0 = robot.stand.copy()
         self.fk = BodyModel(robot)

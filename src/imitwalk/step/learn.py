@@ -20,8 +20,9 @@ eval robots where the start fell none; on the turning clip one kept for a single
 fewer (3 against 4 of 10) kept 14 of `hard`'s 40 up against the start's 19.
 
 The run folder holds ``cma.pkl`` (the optimiser) and ``log.jsonl`` after every
-generation; the optimiser's random draws are seeded per generation, so ``resume`` ends
-exactly where an uninterrupted run would.
+generation; the optimiser's random draws are seeded per generation, and its covariance
+matrix is stored whole beside its pickle (which keeps one triangle of it), so ``resume``
+ends exactly where an uninterrupted run would.
 """
 
 from __future__ import annotations
@@ -55,6 +56,14 @@ __all__ = ["SEARCHED", "StepLearnConfig", "StepLearnResult", "learn_step"]
 KEEP_MARGIN = 2
 #: The gains searched by default: all of them.
 SEARCHED = tuple(BOUNDS)
+#: The checkpoint's entry holding, whole, the optimiser's arrays that its pickle does not
+#: keep exactly (:data:`_INEXACT`).
+_EXACT = "cma_exact"
+#: The arrays of ``cmaes.CMA`` that its ``__getstate__`` stores inexactly: ``_C``, the
+#: covariance matrix, of which it keeps one triangle and rebuilds a symmetric matrix,
+#: while the live one is not exactly symmetric after the second generation (a resumed
+#: run's eigenvectors, and so its candidates, would differ from an uninterrupted run's).
+_INEXACT = ("_C",)
 
 
 @dataclass(frozen=True)
@@ -150,7 +159,36 @@ def _checkpoint(rd: RunDir) -> dict:
         raise RunError(f"{path} is not a stepping-gait checkpoint (expected {', '.join(keys)})")
     if not isinstance(saved["cma"], CMA) or not isinstance(saved["log"], list):
         raise RunError(f"{path} is not a stepping-gait checkpoint (its optimiser or log)")
+    _restore_exact(saved["cma"], saved.get(_EXACT, {}), path)
     return saved
+
+
+def _exact_state(opt: Any) -> dict[str, np.ndarray]:
+    """Copies of the optimiser's arrays its pickle keeps inexactly (:data:`_INEXACT`)."""
+    return {name: np.array(getattr(opt, name), copy=True) for name in _INEXACT}
+
+
+def _restore_exact(opt: Any, exact: object, path: Path) -> None:
+    """Put the arrays :func:`_exact_state` stored back into the unpickled ``opt`` (a
+    checkpoint written before they were stored has none: its optimiser stays as
+    unpickled). A one-line :class:`RunError` for arrays of another name or shape."""
+    if not isinstance(exact, dict) or any(k not in _INEXACT for k in exact):
+        raise RunError(
+            f"{path} is not a stepping-gait checkpoint (its {_EXACT} holds {', '.join(_INEXACT)})"
+        )
+    for name, value in exact.items():
+        live = getattr(opt, name, None)
+        if not (
+            isinstance(value, np.ndarray)
+            and isinstance(live, np.ndarray)
+            and value.shape == live.shape
+            and value.dtype == live.dtype
+        ):
+            raise RunError(
+                f"{path} is not a stepping-gait checkpoint (its {_EXACT} {name} is not the "
+                "optimiser's array)"
+            )
+        setattr(opt, name, value)
 
 
 def _robots(
@@ -239,6 +277,15 @@ def _optimiser(
     return opt, [], 0.0, 0.0
 
 
+def _ask(opt: Any, cfg: StepLearnConfig, gen: int) -> list[np.ndarray]:
+    """Generation ``gen``'s (from 0) candidates, ``cfg.population`` points of the unit box
+    of the searched gains' ranges, each ``(len(cfg.names),)``."""
+    # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
+    # random state, and a resumed run must draw what an uninterrupted one would
+    opt.reseed_rng(cfg.seed * 100_003 + gen)
+    return [opt.ask() for _ in range(opt.population_size)]
+
+
 def _generation(
     opt: Any,
     gen: int,
@@ -253,10 +300,7 @@ def _generation(
     """One generation ``gen`` (from 0): its candidates walk fresh training robots, the
     optimiser is told their costs, and ``log`` gains its line. Returns the simulated
     seconds walked [s]."""
-    # the optimiser's draws are seeded per generation: ``cmaes`` does not pickle its
-    # random state, and a resumed run must draw what an uninterrupted one would
-    opt.reseed_rng(cfg.seed * 100_003 + gen)
-    xs = [opt.ask() for _ in range(opt.population_size)]
+    xs = _ask(opt, cfg, gen)
     cands = [start.with_vector(cfg.names, x) for x in xs]
     draws = _robots(protocol, robot, TRAIN_FIRST + gen * cfg.robots, cfg.robots, cfg.seconds)
     scores = _walk_all(cands, draws, robot, styles, cfg)
@@ -285,9 +329,18 @@ def _generation(
 def _save(
     rd: RunDir, cfg: StepLearnConfig, opt: Any, log: list[dict], spent: float, wall: float
 ) -> None:
-    """The checkpoint (``cma.pkl``: the optimiser, the log, the simulated and wall seconds
-    spent [s]) and ``log.jsonl``, each written whole."""
-    state = {"config": cfg.to_dict(), "cma": opt, "log": log, "sim_seconds": spent, "wall": wall}
+    """The checkpoint (``cma.pkl``: the optimiser, the arrays its pickle keeps inexactly,
+    the log, the simulated and wall seconds spent [s]) and ``log.jsonl``, each written
+    whole. The live optimiser is left as it is: an uninterrupted run is not changed by
+    its checkpoints."""
+    state = {
+        "config": cfg.to_dict(),
+        "cma": opt,
+        _EXACT: _exact_state(opt),
+        "log": log,
+        "sim_seconds": spent,
+        "wall": wall,
+    }
     blob = pickle.dumps(state)
     atomic_write(rd.file("cma.pkl"), lambda tmp: tmp.write_bytes(blob))
     rd.write_log(log)

@@ -57,13 +57,16 @@ def gait_from_motion(
     clip played backward in time (:func:`~imitwalk.step.style.reversed_in_time`).
 
     Raises:
-        MocapError: the clip holds no steady walking cycle, straight or turning.
+        MocapError: the clip holds no frames, or no steady walking cycle, straight or
+            turning.
         ConfigError: the robot's legs cannot make the style's step.
     """
     from imitwalk.retarget.ik import leg_geometry
     from imitwalk.retarget.template import extract_template
     from imitwalk.step.style import reversed_in_time, style_from_template
 
+    if motion.n_frames == 0:
+        raise MocapError(f"no walking cycle found in {motion.source}: it holds no frames")
     try:
         template = extract_template(motion)
     except MocapError:
@@ -99,7 +102,8 @@ def learn_clip(
     ``protocol`` draws the training robots (:attr:`StepLearnConfig.protocol`'s).
 
     Raises:
-        RunError: ``out`` holds another run (without ``resume``), or nothing to resume.
+        RunError: ``out`` holds another run (without ``resume``) or files that are not a
+            run, or nothing to resume.
     """
     rd = RunDir(out)
     t0 = time.perf_counter()
@@ -113,8 +117,7 @@ def learn_clip(
     # the search starts from the shipped gains of the walk's direction
     start = shipped_gains(backward=gait.style.backward)
     if not resume:
-        if rd.exists("config.json") or rd.exists("checkpoint.json"):
-            raise RunError(f"{rd.path} already holds a run; pass --resume or choose another --out")
+        rd.check_new(resume=False)  # another run, or a folder of the user's own files
         # the stride first: the run's files are written once it is chosen, so a run
         # stopped here is started again, not resumed
         style, pace = choose_stride(
