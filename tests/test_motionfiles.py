@@ -261,6 +261,36 @@ def test_convert_writes_both_formats_and_refuses_bad_input(tiny_reference, tmp_p
             ],
             "--cycles",
         ),
+        (  # a bound: 100 000 cycles ran for minutes, its memory growing
+            [
+                "convert",
+                str(ref_path),
+                "--to",
+                "gmr",
+                "--out",
+                str(tmp_path / "f.pkl"),
+                "--cycles",
+                "100000",
+            ],
+            "expected 1 to 1000",
+        ),
+        (  # a robot motion is written as it is: a reference's settings are not ignored
+            [
+                "convert",
+                str(tmp_path / "a.pkl"),
+                "--to",
+                "locomujoco",
+                "--out",
+                str(tmp_path / "g.npz"),
+                "--scale",
+                "0.5",
+            ],
+            "--scale: only for a reference",
+        ),
+        (
+            ["convert", str(tmp_path), "--to", "gmr", "--out", str(tmp_path / "h.pkl")],
+            "is a folder",
+        ),
     ]
     for argv, word in bad:
         assert main(argv) == 2

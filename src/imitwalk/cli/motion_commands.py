@@ -12,6 +12,8 @@ __all__ = ["add_parser", "convert"]
 
 #: What ``--to`` writes, and the extension of each.
 TARGETS = {"gmr": ".pkl", "locomujoco": ".npz"}
+#: A reference's gait cycles written by default, and at most (each about a second).
+CYCLES, MAX_CYCLES = 4, 1000
 
 
 def _is_reference(path: Path) -> bool:
@@ -39,10 +41,16 @@ def convert(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.suffix.lower() != TARGETS[args.to]:
         raise ConfigError(f"--to {args.to} writes a {TARGETS[args.to]} file, not {out.name}")
-    if args.cycles < 1:
-        raise ConfigError(f"--cycles {args.cycles}: expected >= 1")
+    if args.cycles is not None and not 1 <= args.cycles <= MAX_CYCLES:
+        raise ConfigError(f"--cycles {args.cycles}: expected 1 to {MAX_CYCLES}")
     check_writable(out)
     src = Path(args.source)
+    if src.is_dir():
+        from imitwalk.errors import MocapError
+
+        raise MocapError(
+            f"{src} is a folder; give a reference .npz, a GMR .pkl or a LocoMuJoCo .npz"
+        )
     if src.suffix.lower() == ".npz" and _is_reference(src):
         from imitwalk.retarget import Reference
 
@@ -51,8 +59,17 @@ def convert(args: argparse.Namespace) -> int:
             args.robot = ref.provenance.robot or ref.robot
             args.joint_map = args.joint_map or ref.provenance.joint_map
         robot = robot_from(args)
-        motion = motion_of_reference(ref, robot, args.scale, args.cycles)
+        cycles = CYCLES if args.cycles is None else args.cycles
+        motion = motion_of_reference(ref, robot, args.scale, cycles)
     else:
+        given = [
+            f for f, v in (("--scale", args.scale), ("--cycles", args.cycles)) if v is not None
+        ]
+        if given:
+            raise ConfigError(
+                f"{' and '.join(given)}: only for a reference .npz (from retarget); "
+                f"{src.name} is a robot motion, written as it is"
+            )
         args.robot = args.robot or "hoap2"
         robot = robot_from(args)
         motion = read_robot_motion(src, robot)
@@ -89,7 +106,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--scale", type=float, default=None, help="a reference's stride scale (its largest)"
     )
     p.add_argument(
-        "--cycles", type=int, default=4, help="a reference's gait cycles after the start (4)"
+        "--cycles",
+        type=int,
+        default=None,
+        help=f"a reference's gait cycles after the start ({CYCLES}; at most {MAX_CYCLES})",
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=convert)
