@@ -7,6 +7,7 @@ and one ``error:`` line naming the file, leaves no output behind, and runs no ph
 from __future__ import annotations
 
 import json
+import pickle
 import shutil
 from pathlib import Path
 
@@ -68,6 +69,7 @@ def _without(key):
         ("empty", "is empty"),
         ("truncated", "truncated or corrupt"),
         ("text", "is not an .npz archive (it begins 'hello world')"),
+        ("a pickle", "is not an .npz archive (a Python pickle)"),
         ("folder", "is a folder"),
         ("missing", "not found"),
         ("no joint_names", "metadata lacks joint_names"),
@@ -91,6 +93,8 @@ def test_playback_refuses_a_broken_reference(reference, tmp_path, capsys, case, 
         path.write_bytes(data[: len(data) // 2])
     elif case == "text":
         path.write_text("hello world")
+    elif case == "a pickle":  # a GMR .pkl renamed: said, its bytes not echoed
+        path.write_bytes(pickle.dumps({"fps": 100.0}))
     elif case == "folder":
         path.mkdir()
     elif case == "no joint_names":

@@ -286,6 +286,20 @@ def test_resume_refuses_another_robot(step_files, op3, hoap2_copy, tmp_path, cap
     assert {p.name: p.read_bytes() for p in run.iterdir()} == before
 
 
+def test_the_python_learn_resumes_only_on_the_runs_robot(step_files, op3, tmp_path):
+    """``imitwalk.learn(..., resume=True)`` refuses another robot's name, as the command
+    does (its settings the run's, so that check passes first)."""
+    import imitwalk as iw
+    from imitwalk.robots import load_robot
+    from imitwalk.step.learn import StepLearnConfig
+
+    run, cfg = _copy(step_files, tmp_path), StepLearnConfig()
+    config = json.loads((run / "config.json").read_text())
+    (run / "config.json").write_text(json.dumps({**config, "learn": cfg.to_dict()}))
+    with pytest.raises(RunError, match="started on robot 'hoap2', not 'op3'"):
+        iw.learn(None, load_robot(str(op3)), run, cfg, resume=True)
+
+
 def test_resume_refuses_another_clip(step_files, tmp_path, capsys):
     run = _copy(step_files, tmp_path)
     source = json.loads((run / "config.json").read_text())["source"]

@@ -99,6 +99,7 @@ def test_demo_writes_a_report(tmp_path, capsys):
     for part in ("The human and the robot", "cadence", "<video", "Evaluation", "Learning"):
         assert part in page, part
     assert "Protocol <b>eval</b>" in page and (out / "protocol_eval.json").is_file()
+    assert json.loads((out / "protocol_eval.json").read_text())["robot"]["name"] == "hoap2"
     assert res["learned_falls"].endswith("/8") and res["default_falls"].endswith("/8")
     assert (out / "before_after.mp4").stat().st_size > 10_000
     assert (out / "filmstrip.png").is_file()

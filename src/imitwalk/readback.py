@@ -85,9 +85,10 @@ def read_npz(
             truncated or corrupt, holds pickled objects, or lacks a required array.
     """
     path = _readable(path, what, error)
-    if _start(path, error, raw=True) != "PK":
-        begins = _start(path, error)
-        raise error(f"{path} is not an .npz archive (it begins {begins!r}); expected {what}")
+    head = _start(path, error, raw=True)
+    if head != "PK":  # a pickle (protocol 2 and up) begins with byte 0x80: said, not shown
+        seems = "a Python pickle" if head[:1] == "\x80" else f"it begins {_start(path, error)!r}"
+        raise error(f"{path} is not an .npz archive ({seems}); expected {what}")
     try:
         with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}

@@ -10,6 +10,7 @@ their defaults are the full-budget versions.
 from __future__ import annotations
 
 import time
+from dataclasses import asdict
 from pathlib import Path
 
 from imitwalk.cli.progress import progress
@@ -25,7 +26,7 @@ def run_demo(out: Path) -> dict:
     """Learn the embedded clip, evaluate and report into ``out``; the summary."""
     from imitwalk.config import apply_overrides
     from imitwalk.evidence.report import write_report
-    from imitwalk.judge.verdict import judge_protocol
+    from imitwalk.judge.verdict import JudgedRobot, judge_protocol
     from imitwalk.mocap import default_clip, load_motion
     from imitwalk.retarget.provenance import Provenance
     from imitwalk.robots import load_robot
@@ -60,7 +61,8 @@ def run_demo(out: Path) -> dict:
         "[3/4] evaluate: learned and shipped gains on the eval protocol's first 8 robots x 20 s"
     )
     ev = judge_protocol(out, robot, load_protocol("eval"), 8, 20.0)
-    rd.write_json("protocol_eval.json", ev.to_dict())
+    judged = JudgedRobot(robot.name, "hoap2")  # recorded as `imitwalk evaluate` does
+    rd.write_json("protocol_eval.json", {**ev.to_dict(), "robot": asdict(judged)})
     progress("[4/4] report: film strips, video")
     report = write_report(out, robot, progress=lambda s: progress("      " + s))
     side = ev.controllers

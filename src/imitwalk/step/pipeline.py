@@ -103,7 +103,7 @@ def learn_clip(
 
     Raises:
         RunError: ``out`` holds another run (without ``resume``) or files that are not a
-            run, or nothing to resume.
+            run, or nothing to resume, or a run of other settings or another robot.
     """
     rd = RunDir(out)
     t0 = time.perf_counter()
@@ -111,8 +111,14 @@ def learn_clip(
     if resume:
         if not rd.exists("style.json"):
             raise RunError(f"nothing to resume in {rd.path}: no style.json")
-        if rd.read_json("config.json").get("learn") != cfg.to_dict():
+        started = rd.read_json("config.json")
+        if started.get("learn") != cfg.to_dict():
             raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
+        if started.get("robot", robot.name) != robot.name:
+            raise RunError(
+                f"{rd.path} was started on robot {started['robot']!r}, not {robot.name!r}; "
+                "resume it on that robot, or learn into a new folder"
+            )
         gait = StepGait.load(rd.file("style.json"))
     # the search starts from the shipped gains of the walk's direction
     start = shipped_gains(backward=gait.style.backward)
