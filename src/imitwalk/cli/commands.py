@@ -77,6 +77,7 @@ def playback(args: argparse.Namespace) -> int:
     )
     from imitwalk.retarget import Reference
     from imitwalk.retarget.playback import play_reference, summary
+    from imitwalk.retarget.robotmotion import check_reference_robot
 
     check_scale(args.scale)
     check_seconds(args.seconds)
@@ -88,13 +89,7 @@ def playback(args: argparse.Namespace) -> int:
         args.robot = ref.provenance.robot or ref.robot
         args.joint_map = ref.provenance.joint_map
     robot = robot_from(args)
-    if ref.robot != robot.name or tuple(ref.joint_names) != robot.joint_names:
-        from imitwalk.errors import MocapError
-
-        raise MocapError(
-            f"{args.reference}: a reference of robot {ref.robot!r}, not {robot.name!r} "
-            f"(retarget the clip with --robot {robot_label(args)})"
-        )
+    check_reference_robot(ref, robot)
     seeds = list(range(args.models))
     progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
     runs = play_reference(

@@ -37,6 +37,8 @@ from imitwalk.envs.tracking import sole_offsets
 from imitwalk.errors import ConfigError, unknown_name
 from imitwalk.sim.mujoco import MujocoPlant
 from imitwalk.sim.truth import body_truth
+from imitwalk.sim.types import checked_targets
+from imitwalk.step.fields import shown
 
 if TYPE_CHECKING:
     from imitwalk.sim.render import Renderer
@@ -54,32 +56,10 @@ def _heading(quat: np.ndarray) -> float:
     return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
 
-def _checked_action(action: Any, n: int) -> np.ndarray:
-    """``action`` as a ``(n,)`` float array [rad], or a one-line :class:`ConfigError`."""
-    want = f"expected a ({n},) array of finite numbers [rad], the action space's shape"
-    a = np.asarray(action)
-    if a.dtype.kind not in "iuf":
-        raise ConfigError(f"action {_short(action)}: not numbers; {want}")
-    if a.shape != (n,):
-        raise ConfigError(f"action of shape {a.shape}: {want}")
-    a = a.astype(float)
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        i = int(bad[0])
-        raise ConfigError(f"action[{i}] = {a[i]}: not finite ({bad.size} of {n}); {want}")
-    return a
-
-
-def _short(x: Any) -> str:
-    """``repr(x)`` on one line, cut to 40 characters."""
-    text = " ".join(repr(x).split())
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 def _robot_seed(v: Any) -> int:
     """``reset``'s ``robot_seed`` option: a whole number ≥ 0 (not a bool or a float)."""
     if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
-        raise ConfigError(f"robot_seed={_short(v)}: must be a whole number ≥ 0")
+        raise ConfigError(f"robot_seed={shown(v)}: must be a whole number ≥ 0")
     return int(v)
 
 
@@ -125,7 +105,7 @@ class WalkEnv(gym.Env):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         options = options or {}
         if not isinstance(options, dict):
-            raise ConfigError(f"options={_short(options)}: expected a dictionary or None")
+            raise ConfigError(f"options={shown(options)}: expected a dictionary or None")
         for name in options:  # checked before anything changes
             if name not in RESET_OPTIONS:
                 raise unknown_name("reset option", str(name), RESET_OPTIONS, ConfigError)
@@ -167,7 +147,9 @@ class WalkEnv(gym.Env):
         if self.plant is None:
             raise gym.error.ResetNeeded("call reset() before step()")
         s, cfg = self.setup, self.setup.config
-        a = np.clip(_checked_action(action, len(s.low)), s.low, s.high)
+        a = np.clip(
+            checked_targets(action, s.robot.joint_names, s.robot.name, "action"), s.low, s.high
+        )
         targets = a + self.base if self.base is not None else a
         self.plant.command(targets)
         obs = self.plant.step()

@@ -32,7 +32,14 @@ from imitwalk.robots import Robot
 if TYPE_CHECKING:
     from imitwalk.retarget.reference import Reference
 
-__all__ = ["BALL", "MotionModel", "RobotMotion", "clip_of_motion", "motion_of_reference"]
+__all__ = [
+    "BALL",
+    "MotionModel",
+    "RobotMotion",
+    "check_reference_robot",
+    "clip_of_motion",
+    "motion_of_reference",
+]
 
 #: The ball of the foot (a clip's ``toe``) lies this share of the sole's length ahead of
 #: the sole's centre.
@@ -153,6 +160,15 @@ def _rz(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def check_reference_robot(ref: Reference, robot: Robot) -> None:
+    """Refuse, in one line (:class:`MocapError`), a reference retargeted to another robot
+    than ``robot`` (another name or other joints)."""
+    if ref.robot != robot.name or tuple(ref.joint_names) != robot.joint_names:
+        raise MocapError(
+            f"the reference is of robot {ref.robot!r}, not {robot.name!r}; retarget the clip to it"
+        )
+
+
 def motion_of_reference(
     ref: Reference, robot: Robot, scale: float | None = None, cycles: int = 4
 ) -> RobotMotion:
@@ -163,8 +179,7 @@ def motion_of_reference(
     Args:
         ref: a :class:`~imitwalk.retarget.reference.Reference` of ``robot``.
     """
-    if ref.robot != robot.name or tuple(ref.joint_names) != robot.joint_names:
-        raise MocapError(f"the reference is of robot {ref.robot!r}, not {robot.name!r}")
+    check_reference_robot(ref, robot)
     scale = float(ref.scales[-1]) if scale is None else scale
     start, loop, _ = ref.at_scale(scale)
     q = np.concatenate([start, *([loop] * cycles)])

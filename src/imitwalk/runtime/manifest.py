@@ -3,14 +3,14 @@ field.
 
 The manifest is the one file of an export its SHA-256 list cannot cover, and the one a
 robot is wired from (joint order, signs, ranges; the sensor vector; the control rate).
-:func:`read_manifest` therefore checks every field the runtime or a robot loop uses,
-each refused in one line (:class:`~imitwalk.errors.RunError`): the control period
-``dt_s`` finite and within :data:`DT_RANGE` [s], and ``rate_hz`` its inverse; each joint
-an object with a name, an MJCF joint, a sign of +1 or -1, ``rad``, and a finite range
-``lo < hi`` [rad]; the sensor vector's blocks in order, with their sizes and units; the
-robot's name a string. :func:`check_robot` then holds them to ``robot.json`` (which the
-SHA-256 list covers). :func:`is_export` says whether a folder is an earlier export that
-``imitwalk export`` may replace.
+:func:`read_manifest` therefore checks the fields the runtime reads, each refused in one
+line (:class:`~imitwalk.errors.RunError`): the control period ``dt_s`` finite and within
+:data:`DT_RANGE` [s], and ``rate_hz`` its inverse; the robot's name a string; the files
+listed, with their SHA-256. :func:`check_robot` then holds the robot's name, the joints
+(name, MJCF joint, sign, unit, standing angle, range) and the sensor blocks to what
+:func:`build_manifest` writes for the export's ``robot.json`` (which the SHA-256 list
+covers), naming the first field that differs. :func:`is_export` says whether a folder is
+an earlier export that ``imitwalk export`` may replace.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from imitwalk import readback
 from imitwalk.errors import RunError
 from imitwalk.robots.saved import MUJOCO_VERSION, ROBOT_FILES
 from imitwalk.runtime.sensors import BLOCKS, SensorLayout
+from imitwalk.step.fields import shown
 
 if TYPE_CHECKING:
     from imitwalk.robots import Robot
@@ -81,29 +82,23 @@ def sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def build_manifest(
-    r: Robot,
-    lay: SensorLayout,
-    controller: str,
-    source: dict[str, Any],
-    dt: float,
-    files: dict[str, str],
-) -> dict[str, Any]:
-    """The manifest of a bundle: its robot ``r``, sensor layout ``lay``, controller kind,
-    ``source`` (the run it came from), control period ``dt`` [s] and the SHA-256 of its
-    other ``files``."""
-    blocks = []
-    for name, unit in BLOCKS:
-        block: dict[str, Any] = {"name": name, "size": lay.sizes[name], "unit": unit}
-        block["frame"] = _FRAMES[name]
-        if name == "gyro":
-            block["mjcf_sensor"] = r.gyro
-        elif name == "accel":
-            block["mjcf_sensor"] = r.accelerometer
-        elif name == "foot_force":
-            block["mjcf_sensors"] = [*r.foot_force["l"], *r.foot_force["r"]]
-        blocks.append(block)
-    joints = [
+def _blocks(r: Robot, lay: SensorLayout) -> list[dict[str, Any]]:
+    """The manifest's sensor blocks of robot ``r`` (without their ``frame`` texts)."""
+    mjcf: dict[str, dict[str, Any]] = {
+        "gyro": {"mjcf_sensor": r.gyro},
+        "accel": {"mjcf_sensor": r.accelerometer},
+        "foot_force": {"mjcf_sensors": [*r.foot_force["l"], *r.foot_force["r"]]},
+    }
+    return [
+        {"name": name, "size": lay.sizes[name], "unit": unit, **mjcf.get(name, {})}
+        for name, unit in BLOCKS
+    ]
+
+
+def _joints(r: Robot) -> list[dict[str, Any]]:
+    """The manifest's joints of robot ``r``: name, MJCF joint, sign, unit, standing angle
+    and range [rad]."""
+    return [
         {
             "name": n,
             "mjcf_joint": mj,
@@ -116,8 +111,22 @@ def build_manifest(
             r.joint_names, r.mj_joints, r.signs, r.stand, r.limits, strict=True
         )
     ]
+
+
+def build_manifest(
+    r: Robot,
+    lay: SensorLayout,
+    controller: str,
+    source: dict[str, Any],
+    dt: float,
+    files: dict[str, str],
+) -> dict[str, Any]:
+    """The manifest of a bundle: its robot ``r``, sensor layout ``lay``, controller kind,
+    ``source`` (the run it came from), control period ``dt`` [s] and the SHA-256 of its
+    other ``files``."""
     from imitwalk import __version__
 
+    blocks = [{**b, "frame": _FRAMES[b["name"]]} for b in _blocks(r, lay)]
     return {
         readback.FORMAT_KEY: BUNDLE_FORMAT,
         "kind": KIND,
@@ -126,7 +135,7 @@ def build_manifest(
         "source": source,
         "robot": r.name,
         "control": {"rate_hz": 1.0 / dt, "dt_s": dt},
-        "joints": joints,
+        "joints": _joints(r),
         "sensors": {"size": lay.size, "blocks": blocks},
         "output": {
             "name": "joint targets",
@@ -218,22 +227,14 @@ def _real(x: object) -> bool:
 
 
 def _check_fields(m: dict[str, Any], path: Path) -> None:
-    """Refuse, in one line, a field of manifest ``m`` of the wrong type or value."""
+    """Refuse, in one line, a robot name, source or control period of the wrong type or
+    value (the joints and sensors are held to ``robot.json`` by :func:`check_robot`)."""
     if not isinstance(m["robot"], str) or not m["robot"]:
         raise RunError(f"{path}: robot must be the robot's name (a string); got {m['robot']!r}")
     if not isinstance(m.get("source", {}), dict):
         raise RunError(f"{path}: source must be an object (run, learner, controller, scale)")
-    _check_control(m["control"], path)
-    joints = m["joints"]
-    if not isinstance(joints, list) or not joints:
-        raise RunError(f"{path}: joints must be a list of objects, one per joint")
-    for i, j in enumerate(joints):
-        _check_joint(i, j, path)
-    _check_sensors(m["sensors"], path)
-
-
-def _check_control(c: object, path: Path) -> None:
     lo, hi = DT_RANGE
+    c = m["control"]
     if not isinstance(c, dict) or "dt_s" not in c:
         raise RunError(f"{path}: control must be an object with dt_s, the control period [s]")
     dt = c["dt_s"]
@@ -249,77 +250,45 @@ def _check_control(c: object, path: Path) -> None:
         )
 
 
-def _check_joint(i: int, j: object, path: Path) -> None:
-    at = f"{path}: joints[{i}]"
-    if not isinstance(j, dict):
-        raise RunError(f"{at} must be an object (name, mjcf_joint, sign, unit, stand, range)")
-    for key in ("name", "mjcf_joint"):
-        if not isinstance(j.get(key), str) or not j[key]:
-            raise RunError(f"{at}.{key} must be a name (a string); got {j.get(key)!r}")
-    if type(j.get("sign")) is not int or j["sign"] not in (1, -1):
-        raise RunError(f"{at}.sign must be 1 or -1; got {j.get('sign')!r}")
-    if j.get("unit", "rad") != "rad":
-        raise RunError(f"{at}.unit must be 'rad'; got {j['unit']!r}")
-    if "stand" in j and not _real(j["stand"]):
-        raise RunError(f"{at}.stand must be a finite angle [rad]; got {j['stand']!r}")
-    r = j.get("range")
-    if not (isinstance(r, list) and len(r) == 2 and all(map(_real, r)) and r[0] < r[1]):
-        raise RunError(f"{at}.range must be [lo, hi], finite, lo < hi [rad]; got {r!r}")
-
-
-def _check_sensors(s: object, path: Path) -> None:
-    names = [name for name, _ in BLOCKS]
-    if not isinstance(s, dict) or type(s.get("size")) is not int or s["size"] < 1:
-        raise RunError(f"{path}: sensors must be an object with size (an integer) and blocks")
-    blocks = s.get("blocks")
-    if not isinstance(blocks, list) or not all(isinstance(b, dict) for b in blocks):
-        raise RunError(f"{path}: sensors.blocks must be a list of objects ({', '.join(names)})")
-    got = [(b.get("name"), b.get("unit")) for b in blocks]
-    if got != list(BLOCKS):
-        want = ", ".join(f"{n} [{u}]" for n, u in BLOCKS)
-        raise RunError(f"{path}: sensors.blocks must be {want}, in this order")
-    sizes = [b.get("size") for b in blocks]
-    if not all(type(n) is int and n >= 0 for n in sizes) or sum(sizes) != s["size"]:
-        raise RunError(f"{path}: sensors.blocks' sizes {sizes} do not add up to {s['size']!r}")
-
-
 def check_robot(m: dict[str, Any], robot: Robot, path: Path) -> None:
-    """Refuse, in one line, a checked manifest ``m`` that disagrees with the export's
-    ``robot.json`` (``robot``): the robot's name, each joint's name, MJCF joint, sign,
-    standing angle and range, and the sensor blocks' sizes and MJCF sensors."""
-    again = "export the run again"
-    if m["robot"] != robot.name:
-        raise RunError(f"{path}: robot {m['robot']!r} is not robot.json's {robot.name!r}; {again}")
-    names = [j["name"] for j in m["joints"]]
-    if names != list(robot.joint_names):
-        raise RunError(f"{path}: its joints disagree with robot.json; {again}")
-    rows = zip(m["joints"], robot.mj_joints, robot.signs, robot.stand, robot.limits, strict=True)
-    for j, mj, sign, stand, (lo, hi) in rows:
-        want: dict[str, Any] = {"mjcf_joint": mj, "sign": int(sign), "stand": float(stand)}
-        want["range"] = [float(lo), float(hi)]
-        for key, val in want.items():
-            got = j.get(key, val)
-            if not (got == val if key in ("mjcf_joint", "sign") else _close(got, val)):
-                raise RunError(
-                    f"{path}: joint {j['name']!r} {key} {got!r} disagrees with robot.json "
-                    f"({val!r}); {again}"
-                )
-
+    """Refuse, in one line, a manifest ``m`` whose robot, joints (name, MJCF joint, sign,
+    unit, standing angle, range) or sensor blocks (name, size, unit, MJCF sensors) are not
+    the ones :func:`build_manifest` writes for the export's ``robot.json`` (``robot``)."""
     lay = SensorLayout(len(robot.foot_force["l"]), robot.dof)
-    blocks = {b["name"]: b for b in m["sensors"]["blocks"]}
-    mjcf = {
-        "gyro": ("mjcf_sensor", robot.gyro),
-        "accel": ("mjcf_sensor", robot.accelerometer),
-        "foot_force": ("mjcf_sensors", [*robot.foot_force["l"], *robot.foot_force["r"]]),
-    }
-    for name, n in lay.sizes.items():
-        key, sensor = mjcf.get(name, ("", None))
-        if blocks[name]["size"] != n or (key and blocks[name].get(key, sensor) != sensor):
-            raise RunError(f"{path}: its sensors block {name!r} disagrees with robot.json; {again}")
+    want = {"size": lay.size, "blocks": _blocks(robot, lay)}
+    for at, got, exp in (
+        ("robot", m["robot"], robot.name),
+        ("joints", m["joints"], _joints(robot)),
+        ("sensors", m["sensors"], want),
+    ):
+        where = _difference(got, exp, at)
+        if where is not None:
+            raise RunError(
+                f"{path}: {where[0]} is {shown(where[1])}, not robot.json's {shown(where[2])}; "
+                "export the run again"
+            )
 
 
-def _close(a: object, b: float | list[float]) -> bool:
-    """``a`` equals ``b`` (a number or a list of them) within 1e-9."""
-    if isinstance(b, list):
-        return isinstance(a, list) and len(a) == len(b) and all(map(_close, a, b))
-    return isinstance(a, int | float) and _real(a) and abs(a - b) <= 1e-9
+def _difference(got: object, want: object, at: str) -> tuple[str, object, object] | None:
+    """The first place where ``got`` differs from ``want`` (the keys of ``want`` only),
+    as (its path, e.g. ``joints[3] (l_knee).sign``, the value there, the one wanted);
+    ``None`` if nowhere. Numbers are equal only exactly (JSON keeps a float's bits)."""
+    if isinstance(want, dict):
+        if not isinstance(got, dict):
+            return at, got, want
+        for key, w in want.items():
+            found = _difference(got.get(key), w, f"{at}.{key}")
+            if found is not None:
+                return found
+        return None
+    if isinstance(want, list):
+        if not isinstance(got, list) or len(got) != len(want):
+            return at, got, want
+        for i, (g, w) in enumerate(zip(got, want, strict=True)):
+            label = f" ({w['name']})" if isinstance(w, dict) and "name" in w else ""
+            found = _difference(g, w, f"{at}[{i}]{label}")
+            if found is not None:
+                return found
+        return None
+    same = type(got) is type(want) or (_real(got) and _real(want) and type(want) is float)
+    return None if same and got == want else (at, got, want)

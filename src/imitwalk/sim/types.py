@@ -137,27 +137,35 @@ def checked_targets(
     targets: object, joint_names: tuple[str, ...], robot: str, what: str = "joint targets"
 ) -> np.ndarray:
     """``targets`` as ``(n,)`` finite joint angles [rad], one per name of ``joint_names``
-    (of the robot named ``robot``; ``what``: what they are, for the message).
+    (of the robot named ``robot``; ``what``: what they are, for the message): the one
+    check of every target the simulator or the environment is handed. Ints and floats
+    pass (the same array if already float64); bools, text and objects do not.
 
     Raises:
-        ConfigError: not numbers, another shape (e.g. another robot's), or not finite
-            (MuJoCo would silently zero a NaN control, driving its joint to 0 rad).
+        ConfigError: not numbers, another shape (e.g. another robot's, nothing is
+            broadcast), or not finite (MuJoCo would silently zero a NaN control, driving
+            its joint to 0 rad).
     """
     n = len(joint_names)
-    want = f"expected {n} finite numbers [rad], one per joint of {robot!r}"
     try:
-        a = np.asarray(targets, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{what}: not numbers; {want}") from None
+        a = np.asarray(targets)
+    except ValueError:  # a ragged list
+        a = np.asarray(None, dtype=object)
+    numbers = a.dtype.kind in "iuf"
+    if numbers and a.shape == (n,):
+        a = a.astype(float, copy=False)
+        if np.isfinite(a).all():  # every tick: one pass
+            return a
+    want = f"expected {n} finite numbers [rad], a ({n},) array, one per joint of {robot!r}"
+    if not numbers:
+        raise ConfigError(f"{what}: not numbers (a {type(targets).__name__}); {want}")
     if a.shape != (n,):
         raise ConfigError(f"{what} of shape {a.shape}: {want}")
     bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        i = int(bad[0])
-        raise ConfigError(
-            f"{what}: {joint_names[i]} is {a[i]} ({bad.size} of {n} not finite); {want}"
-        )
-    return a
+    i = int(bad[0])
+    raise ConfigError(
+        f"{what}[{i}] = {a[i]}: {joint_names[i]} is {a[i]} ({bad.size} of {n} not finite); {want}"
+    )
 
 
 def jitter_draws(
