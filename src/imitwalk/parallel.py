@@ -80,23 +80,28 @@ def run_parallel(
     workers = min(len(jobs), workers or default)
     if workers <= 1:
         return _until(jobs, fn, stop)
-    ctx = multiprocessing.get_context()
-    done = ctx.RawValue("b", 0)
-    pool = ProcessPoolExecutor(
-        max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(done,)
-    )
     ahead = workers if stop is not None else len(jobs)  # jobs started beyond the first untaken
     futures: list = []
+    pool: ProcessPoolExecutor | None = None
 
     # each next job is started only once the result before is taken
     def in_order() -> Iterator[Future]:
+        assert pool is not None
         for k in range(len(jobs)):
             yield futures[k]
             if len(futures) < len(jobs):
                 futures.append(pool.submit(fn, jobs[len(futures)]))
 
     try:
-        with _ctrl_c_held():  # an interrupt while the pool starts would orphan its workers
+        # Ctrl-C is held while the pool starts: an interrupt then would orphan its workers,
+        # and one raised in the imports a process's first map makes (ctypes, the locks,
+        # the fork) would be lost, since Python ignores it in an import lock's clean-up
+        with _ctrl_c_held():
+            ctx = multiprocessing.get_context()
+            done = ctx.RawValue("b", 0)
+            pool = ProcessPoolExecutor(
+                max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(done,)
+            )
             futures = [pool.submit(fn, j) for j in jobs[:ahead]]
         out = _until(in_order(), lambda f: f.result(), stop)
         done.value = 1  # the jobs still running may end early
@@ -104,10 +109,11 @@ def run_parallel(
         if spent is not None:
             spent.extend(f.result() for f in ran)
     except BaseException:  # Ctrl-C or a failed job: drop the jobs not yet started
-        done.value = 1
-        for f in futures:
-            f.cancel()
-        pool.shutdown(wait=False, cancel_futures=True)
+        if pool is not None:
+            done.value = 1
+            for f in futures:
+                f.cancel()
+            pool.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown()
     return out
