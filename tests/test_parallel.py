@@ -96,8 +96,8 @@ def job(x):
     return x
 
 if __name__ == "__main__":
-    print("start", flush=True)
     try:
+        print("start", flush=True)
         run_parallel(job, list(range(200)), workers=2,
                      stop=(lambda out: False) if sys.argv[2] == "stop" else None)
     except KeyboardInterrupt:
