@@ -1,5 +1,7 @@
 """Writing files (pure Python; NumPy only for ``.npz``): atomically, so that a reader
-never sees a half-written file, and to paths checked before any work starts."""
+never sees a half-written file, durably (on disk before it is named, so that a machine
+that loses power keeps the old file or the new one, never an empty one), and to paths
+checked before any work starts."""
 
 from __future__ import annotations
 
@@ -11,11 +13,44 @@ from typing import Any
 
 from imitwalk.errors import ConfigError, ImitwalkError
 
-__all__ = ["atomic_write", "check_writable", "writable_folder", "write_npz"]
+__all__ = [
+    "atomic_write",
+    "check_writable",
+    "sync_file",
+    "sync_folder",
+    "writable_folder",
+    "write_npz",
+]
+
+
+def sync_file(path: str | Path) -> None:
+    """Flush ``path``'s data to the disk (``fsync``)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def sync_folder(folder: str | Path) -> None:
+    """Flush ``folder``'s entries to the disk, so that a rename into it lasts (POSIX; a
+    no-op where a folder cannot be opened, as on Windows)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # some file systems refuse fsync on a folder: the rename is all they keep
+    finally:
+        os.close(fd)
 
 
 def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
-    """Write a file atomically: ``write(tmp_path)`` then rename over ``path``."""
+    """Write a file atomically and durably: ``write(tmp_path)``, flushed to the disk,
+    renamed over ``path``, and the rename flushed (:func:`sync_file`,
+    :func:`sync_folder`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -25,7 +60,9 @@ def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file normal permissions
+        sync_file(tmp)
         os.replace(tmp, path)
+        sync_folder(path.parent)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)

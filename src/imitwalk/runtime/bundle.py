@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 from imitwalk import readback
 from imitwalk.errors import ConfigError, ImitwalkError, RunError, unknown_name
+from imitwalk.fileio import sync_file, sync_folder
 from imitwalk.robots import Robot
 from imitwalk.robots.saved import load_saved_robot, save_robot
 from imitwalk.runtime.manifest import (
@@ -177,11 +178,15 @@ def write_bundle(b: Bundle, folder: str | Path) -> Path:
             + "\n"
         )
         os.chmod(tmp, 0o755)
+        for p in tmp.iterdir():
+            sync_file(p)
+        sync_folder(tmp)
         old = None
         if folder.exists():
             old = folder.with_name(f".{folder.name}.old-{os.getpid()}")
             os.replace(folder, old)
         os.replace(tmp, folder)
+        sync_folder(folder.parent)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
     finally:
