@@ -432,8 +432,8 @@ def test_bad_bvh_through_a_real_process(shared_mocap, tmp_path):
 @pytest.mark.parametrize("command", ["retarget", "learn"])
 def test_cli_mocap_flags(shared_mocap, tmp_path, command):
     """``--up``, ``--units`` and ``--joint-names`` reach the reader from both commands."""
-    from imitwalk.cli.commands import _motion
     from imitwalk.cli.main import build_parser
+    from imitwalk.cli.retarget_commands import clip_motion
 
     rig = _rig(str(shared_mocap))
     silent = _silent(rig)
@@ -441,7 +441,7 @@ def test_cli_mocap_flags(shared_mocap, tmp_path, command):
     mapping = tmp_path / "names.json"
     mapping.write_text(json.dumps({"head": silent["Head"], "neck": silent["Neck"]}))
     argv = [command, str(path), "--up=-x", "--units", "cmu", "--joint-names", str(mapping)]
-    m = _motion(build_parser().parse_args([*argv, "--out", str(tmp_path / "o")]), robot=None)
+    m = clip_motion(build_parser().parse_args([*argv, "--out", str(tmp_path / "o")]), robot=None)
     assert (m.meta["up_axis"], m.meta["units"]) == ("-x", "cmu") and not m.meta["up_guessed"]
     assert m.meta["joints"]["head"] == silent["Head"] and m.meta["roles"] == "structure"
     assert_same(m, _reference(str(shared_mocap)), 4, names=(*LOWER_BODY, "head", "neck"))

@@ -9,17 +9,24 @@ their defaults are the full-budget versions.
 
 from __future__ import annotations
 
+import argparse
 import time
 from dataclasses import asdict
 from pathlib import Path
 
-from imitwalk.cli.progress import progress
+from imitwalk.cli.progress import emit, progress
 
-__all__ = ["DEMO_LEARN", "run_demo"]
+__all__ = ["DEMO_LEARN", "demo", "run_demo"]
 
 
 #: The demo's learning budget: two generations of four candidates on three robots.
 DEMO_LEARN = ["generations=2", "population=4", "robots=3", "seconds=6", "final_robots=3"]
+
+
+def demo(args: argparse.Namespace) -> int:
+    """``imitwalk demo``: :func:`run_demo` into ``--out``, its summary printed."""
+    emit(run_demo(Path(args.out)), args.json)
+    return 0
 
 
 def run_demo(out: Path) -> dict:

@@ -1,6 +1,7 @@
 """The ``imitwalk`` command line.
 
-Every subcommand is a thin wrapper over the library (:mod:`imitwalk.cli.commands`). Errors
+Every subcommand is a thin wrapper over the library, in a module of :mod:`imitwalk.cli`
+by concept (``retarget_commands``, ``learn_commands``, ``judge_commands``, ...). Errors
 the library raises on purpose (:class:`~imitwalk.errors.ImitwalkError`) print one line
 on stderr and exit with status 2; no traceback.
 """
@@ -14,11 +15,13 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from imitwalk.cli import (
-    commands,
+    demo,
     export_commands,
     judge_commands,
+    learn_commands,
     motion_commands,
     navigate_commands,
+    retarget_commands,
     rl_commands,
     robot_commands,
     sweep_commands,
@@ -161,7 +164,7 @@ def _add_retarget(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> N
     _settings(rt)
     _command_args(rt)
     rt.add_argument("--json", action="store_true", help="print JSON")
-    rt.set_defaults(func=commands.retarget)
+    rt.set_defaults(func=retarget_commands.retarget)
 
 
 def _add_playback(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -176,7 +179,7 @@ def _add_playback(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> N
     pb.add_argument("--workers", type=int, default=None, help="parallel processes (one per core)")
     _engine_arg(pb, "mujoco", "mujoco")
     pb.add_argument("--json", action="store_true", help="print JSON")
-    pb.set_defaults(func=commands.playback)
+    pb.set_defaults(func=retarget_commands.playback)
 
 
 def _add_learn(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -218,7 +221,7 @@ def _add_learn(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     _command_args(ln)
     ln.add_argument("--json", action="store_true", help="print JSON")
-    ln.set_defaults(func=commands.learn)
+    ln.set_defaults(func=learn_commands.learn)
 
 
 def _add_evaluate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -283,7 +286,7 @@ def _add_demo(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     dm = sub.add_parser("demo", help="retarget the default clip, learn, evaluate, report")
     dm.add_argument("--out", default="imitwalk-demo", help="run folder (imitwalk-demo)")
     dm.add_argument("--json", action="store_true", help="print JSON")
-    dm.set_defaults(func=commands.demo)
+    dm.set_defaults(func=demo.demo)
 
 
 def _one_line_warning(

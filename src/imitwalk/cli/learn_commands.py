@@ -1,122 +1,26 @@
-"""The work behind each CLI subcommand (parsing lives in :mod:`imitwalk.cli.main`)."""
+"""``imitwalk learn``: the stepping gait's gains (the default), or the joint-space
+learners (``--variant extended``, the per-tick learner; ``faithful``, the paper's), into
+a run folder (parsing lives in :mod:`imitwalk.cli.main`)."""
 
 from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from imitwalk.cli.progress import emit, progress
 from imitwalk.cli.resume_checks import check_out, check_resumed_clip, check_resumed_robot
+from imitwalk.cli.retarget_commands import clip_motion, with_command
 from imitwalk.cli.robot_args import recorded_robot, robot_from, robot_label
 
 if TYPE_CHECKING:
     from imitwalk.learning.refchoice import Choice
-    from imitwalk.mocap import Motion
-    from imitwalk.retarget import Reference, RetargetConfig
+    from imitwalk.retarget import RetargetConfig
     from imitwalk.robots import Robot
     from imitwalk.runs import LearnSummary, RunDir
 
-__all__ = ["demo", "learn", "playback", "retarget"]
-
-
-def _motion(args: argparse.Namespace, robot: Robot) -> Motion:
-    """The clip: a mocap file, or ``robot``'s motion from another tool (GMR, LocoMuJoCo)."""
-    from imitwalk.mocap import default_clip
-    from imitwalk.retarget.motionfiles import load_clip
-
-    path = args.file or default_clip()
-    return load_clip(
-        path,
-        robot,
-        skeleton=args.skeleton,
-        units=getattr(args, "units", None),
-        up=getattr(args, "up", None),
-        joint_names=getattr(args, "joint_names", None),
-    )
-
-
-def retarget(args: argparse.Namespace) -> int:
-    from imitwalk.config import apply_overrides
-    from imitwalk.fileio import check_writable
-    from imitwalk.retarget import RetargetConfig
-    from imitwalk.retarget import retarget as run
-
-    check_writable(args.out)
-    robot = robot_from(args)
-    cfg = RetargetConfig(mapping=args.mapping, search=not args.no_search)
-    cfg = _with_command(apply_overrides(cfg, args.set), args)
-    motion = _motion(args, robot)
-    progress(f"retarget: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
-
-    res = run(motion, robot, cfg, progress=search_report)
-    progress(f"  cycles: {res.template.meta['cycles_report']}")
-    _named(res.reference, args).save(args.out)
-    stats = res.stats()
-    stats["out"] = str(Path(args.out))
-    emit(stats, args.json)
-    return 0
-
-
-def search_report(gen: int, total: int, score: float, params: dict) -> None:
-    """Progress of the reference search (:mod:`imitwalk.retarget.search`)."""
-    from imitwalk.retarget.search import search_line
-
-    progress(search_line(gen, total, score, params))
-
-
-def playback(args: argparse.Namespace) -> int:
-    from imitwalk.cli.arg_checks import (
-        check_count,
-        check_joint_map_alone,
-        check_scale,
-        check_seconds,
-        check_workers,
-    )
-    from imitwalk.retarget import Reference
-    from imitwalk.retarget.playback import play_reference, summary
-    from imitwalk.retarget.robotmotion import check_reference_robot
-
-    check_scale(args.scale)
-    check_seconds(args.seconds)
-    check_count(args.models, "--models")
-    check_workers(args.workers)
-    check_joint_map_alone(args)
-    ref = Reference.load(args.reference)
-    if args.robot is None:
-        args.robot = ref.provenance.robot or ref.robot
-        args.joint_map = ref.provenance.joint_map
-    robot = robot_from(args)
-    check_reference_robot(ref, robot)
-    seeds = list(range(args.models))
-    progress(f"playback: scale {args.scale:g}, {args.seconds:g} s on {len(seeds)} robots")
-    runs = play_reference(
-        ref, robot, args.scale, args.seconds, seeds, workers=args.workers, engine=args.engine
-    )
-    out = {"scale": args.scale, "seconds": args.seconds, "engine": args.engine, **summary(runs)}
-    emit(out, args.json)
-    return 0
-
-
-def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
-    """``--set`` items for the retargeting (``retarget.``-prefixed) and for learning."""
-    rt = [i.split(".", 1)[1] for i in items if i.startswith("retarget.")]
-    return rt, [i for i in items if not i.startswith("retarget.")]
-
-
-def _named(ref: Reference, args: argparse.Namespace) -> Reference:
-    """``ref`` with the robot as this command named it (for ``evaluate`` to find again)."""
-    where = recorded_robot(args)
-    return replace(ref, provenance=ref.provenance.named(where.robot, where.joint_map))
-
-
-def _with_command(cfg: RetargetConfig, args: argparse.Namespace) -> RetargetConfig:
-    """``cfg`` (a RetargetConfig) with the ``--turn/--side/--forward/--slope`` flags given."""
-    flags = {"turn_deg": "turn", "side_m": "side", "forward": "forward", "slope_deg": "slope"}
-    given = {k: getattr(args, a) for k, a in flags.items() if getattr(args, a, None) is not None}
-    return replace(cfg, command=replace(cfg.command, **given)) if given else cfg
+__all__ = ["learn"]
 
 
 def learn(args: argparse.Namespace) -> int:
@@ -157,7 +61,7 @@ def learn(args: argparse.Namespace) -> int:
     else:
         if args.resume and not args.file:  # the clip is read again: the run's own
             check_resumed_clip(rd, str(default_clip()))
-        motion, rcfg = _motion(args, robot), _with_command(rcfg, args)
+        motion, rcfg = clip_motion(args, robot), with_command(rcfg, args)
         named = recorded_robot(args)
         summary, choice = learn_joint_space(
             motion, robot, args.out, cfg, rcfg, args.resume, progress, named
@@ -166,6 +70,12 @@ def learn(args: argparse.Namespace) -> int:
     progress(f"learn: {args.variant} variant")
     summary = run(ref, robot, cfg, args.out, resume=args.resume, progress=progress)
     return _learned(summary, args, rd)
+
+
+def _split_settings(items: list[str]) -> tuple[list[str], list[str]]:
+    """``--set`` items for the retargeting (``retarget.``-prefixed) and for learning."""
+    rt = [i.split(".", 1)[1] for i in items if i.startswith("retarget.")]
+    return rt, [i for i in items if not i.startswith("retarget.")]
 
 
 def _joint_space_learner(
@@ -284,7 +194,7 @@ def _learn_step(args: argparse.Namespace, robot: Robot) -> int:
         _unused_clip_flags(args)
         progress(f"learn: resuming {rd.path}")
     else:
-        motion = _motion(args, robot)
+        motion = clip_motion(args, robot)
         progress(f"learn: {motion.source} ({motion.n_frames} frames at {motion.fps:g} fps)")
     progress(
         f"learn: stepping gait, gains by CMA-ES on {cfg.protocol}'s training robots "
@@ -321,11 +231,4 @@ def _learned(
         out["reference_choice"] = {**choice.to_dict(), **choice.cost()}
     out["run_dir"] = str(rd.path)
     emit(out, args.json)
-    return 0
-
-
-def demo(args: argparse.Namespace) -> int:
-    from imitwalk.cli.demo import run_demo
-
-    emit(run_demo(Path(args.out)), args.json)
     return 0
