@@ -131,6 +131,25 @@ def test_learn_refuses_a_setting_out_of_range_before_any_work(tick_reference, tm
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    "config", [None, {"format": 1, "learner": "step", "learn": {"robots": 5}, "robot": "hoap2"}]
+)
+def test_the_demo_refuses_a_finished_run_that_is_not_its_own(tmp_path, capsys, config):
+    """A user's own run (or files) is not judged as the demo's and its verdict kept."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "metrics.json").write_text('{"format": 1}\n')
+    if config is not None:
+        (out / "config.json").write_text(json.dumps(config))
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert main(["demo", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert (
+        err.startswith(f"error: --out {out} holds a run that is not the demo's") and "\n" not in err
+    )
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 @pytest.mark.parametrize("command", ["learn", "demo"])
 def test_an_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, command):
     out = tmp_path / "taken"

@@ -13,8 +13,12 @@ import argparse
 import time
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from imitwalk.cli.progress import emit, progress
+
+if TYPE_CHECKING:
+    from imitwalk.runs import RunDir
 
 __all__ = ["DEMO_LEARN", "demo", "run_demo"]
 
@@ -48,7 +52,8 @@ def run_demo(out: Path) -> dict:
     rd.check_writable()
     cfg = apply_overrides(StepLearnConfig(), DEMO_LEARN)
     if rd.exists("metrics.json"):
-        progress(f"demo: {out} already holds a finished run; reusing it")
+        _check_demo_run(rd, cfg.to_dict(), robot.name)
+        progress(f"demo: {out} already holds a finished demo run; reusing it")
     else:
         resume = rd.exists("style.json")
         motion = load_motion(default_clip())
@@ -81,3 +86,24 @@ def run_demo(out: Path) -> dict:
     }
     progress(f"demo: report written to {report}")
     return summary
+
+
+def _check_demo_run(rd: RunDir, learn: dict, robot: str) -> None:
+    """Refuse a finished run that is not the demo's own (``learn``: its settings, on
+    ``robot``): the demo would judge it as its own and overwrite its verdict.
+
+    Raises:
+        RunError: one line naming the folder.
+    """
+    from imitwalk.errors import RunError
+
+    try:
+        config = rd.read_json("config.json")
+    except RunError:
+        config = {}
+    ours = config.get("learner") == "step" and config.get("learn") == learn
+    if not ours or config.get("robot") != robot:
+        raise RunError(
+            f"--out {rd.path} holds a run that is not the demo's (other settings, robot or "
+            "files); nothing was changed: give a new folder, or the demo's own"
+        )
