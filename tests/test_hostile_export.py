@@ -326,6 +326,33 @@ def test_a_manifest_edited_by_hand_is_refused_in_one_line(export, tmp_path, how)
     assert "\n" not in msg and _WORDS[how.split()[0]] in msg, msg
 
 
+def test_an_export_another_mujoco_wrote_is_read_if_this_one_can(export, tmp_path, monkeypatch):
+    """Another MuJoCo's export loads while this MuJoCo reads its model, and is refused in
+    one line naming both versions once it does not."""
+    import mujoco
+
+    from imitwalk.robots import build
+    from imitwalk.runtime import Controller
+
+    other = tmp_path / "other"
+    shutil.copytree(export, other)
+    path = other / "manifest.json"
+    m = json.loads(path.read_text())
+    m["versions"]["mujoco"] = "3.1.0"
+    path.write_text(json.dumps(m))
+    Controller.load(other)
+
+    def unreadable(_path):
+        raise ValueError("Model and executable have different number of ints")
+
+    monkeypatch.setattr(mujoco.MjModel, "from_binary_path", unreadable)
+    monkeypatch.setattr(build, "_MODELS", {})
+    with pytest.raises(RunError) as err:
+        Controller.load(other)
+    msg = str(err.value)
+    assert "\n" not in msg and "MuJoCo 3.1.0" in msg and "install mujoco==3.1.0" in msg, msg
+
+
 #: Values of every JSON type, and numbers a field should not take.
 _JUNK = [None, True, "x", [], {}, -1, 0, 1e308, math.nan, [0.0, math.inf]]
 

@@ -40,7 +40,7 @@ from imitwalk import readback
 from imitwalk.errors import ConfigError, ImitwalkError, RunError, unknown_name
 from imitwalk.fileio import sync_file, sync_folder
 from imitwalk.robots import Robot
-from imitwalk.robots.saved import load_saved_robot, save_robot
+from imitwalk.robots.saved import MUJOCO_VERSION, load_saved_robot, save_robot
 from imitwalk.runtime.manifest import (
     BUNDLE_FORMAT,
     DT_RANGE,
@@ -209,6 +209,7 @@ def read_bundle(folder: str | Path) -> Bundle:
     read = lambda name, what: readback.read_json(folder / name, what, RunError)  # noqa: E731
     try:
         robot = load_saved_robot(folder)
+        _check_model_readable(robot, m, folder)
         dt = float(m["control"]["dt_s"])
         style = gains = actor = None
         if "style.json" in PARTS[kind]:
@@ -226,3 +227,23 @@ def read_bundle(folder: str | Path) -> Bundle:
         raise RunError(f"{folder} is not a usable export: {type(exc).__name__}: {exc}") from None
     check_robot(m, robot, folder / MANIFEST)
     return b
+
+
+def _check_model_readable(robot: Robot, manifest: dict, folder: Path) -> None:
+    """An export written by another MuJoCo than this one is read if this one reads its
+    ``robot.mjb``, and refused in one line naming both versions if it does not.
+
+    Raises:
+        RunError: this MuJoCo cannot read the export's compiled model.
+    """
+    versions = manifest.get("versions")
+    made = versions.get("mujoco") if isinstance(versions, dict) else None
+    if made == MUJOCO_VERSION:
+        return
+    try:
+        robot.compile()
+    except ImitwalkError:
+        raise RunError(
+            f"{folder} was exported with MuJoCo {made}, and this MuJoCo ({MUJOCO_VERSION}) "
+            f"cannot read its robot.mjb: install mujoco=={made}, or export the run again"
+        ) from None
