@@ -311,6 +311,23 @@ def test_resume_refuses_another_clip(step_files, tmp_path, capsys):
         )
 
 
+def test_the_python_learn_resumes_only_with_the_runs_clip(step_files, tmp_path):
+    """``imitwalk.learn(clip, ..., resume=True)`` refuses another clip, a path's or a
+    motion's, as the command does; the run's own (or none) goes on to the next check."""
+    import imitwalk as iw
+    from imitwalk.mocap import default_clip, load_motion
+
+    run = _copy(step_files, tmp_path)
+    source = json.loads((run / "config.json").read_text())["source"]
+    for clip in ("/nonexistent/clip.bvh", tmp_path / "walk.bvh"):
+        with pytest.raises(ConfigError, match=f"was started on the clip {source}"):
+            iw.learn(clip, "hoap2", run, resume=True)
+    motion = load_motion(default_clip())
+    for clip in (None, default_clip(), motion):
+        with pytest.raises(RunError, match="was started with other settings"):
+            iw.learn(clip, "hoap2", run, resume=True)
+
+
 def test_resume_with_the_same_robot_and_clip_goes_on(step_files, tmp_path, capsys):
     """The same robot and clip (given again, or by a copy of the clip's bytes) pass: the
     resume goes on to the next check, the settings (the fixture's are no command's)."""

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from imitwalk import readback
-from imitwalk.errors import RunError
+from imitwalk.errors import ConfigError, RunError
 from imitwalk.fileio import atomic_write, check_writable, writable_folder, write_npz
 
 __all__ = [
@@ -32,6 +32,7 @@ __all__ = [
     "RunDir",
     "StepOutcome",
     "TickOutcome",
+    "check_resumed_clip",
 ]
 
 #: The format of a run folder's ``config.json`` and ``metrics.json`` that this imitwalk
@@ -40,6 +41,29 @@ __all__ = [
 RUN_FORMAT = 1
 #: The run files that carry a ``format``.
 _VERSIONED = ("config.json", "metrics.json")
+
+
+def check_resumed_clip(run: Path, recorded: object, given: str) -> None:
+    """Refuse to resume the run in ``run``, which records its clip as ``recorded`` (a path;
+    anything else records none), with the clip ``given``: it passes as the same file, a
+    file of the same bytes, or (the recorded path not found from here) a file of its name.
+
+    Raises:
+        ConfigError: one line naming both clips.
+    """
+    import filecmp
+
+    if not isinstance(recorded, str) or not recorded:
+        return
+    was, now = Path(recorded), Path(given)
+    if was.resolve() == now.resolve() or (not was.exists() and was.name == now.name):
+        return
+    if was.is_file() and now.is_file() and filecmp.cmp(was, now, shallow=False):
+        return
+    raise ConfigError(
+        f"{given}: {run} was started on the clip {recorded}; resume it without a clip "
+        "(or with that one), or learn this clip into a new folder"
+    )
 
 
 def _json_default(v: object) -> object:

@@ -5,7 +5,6 @@ own robot and clip (never another's)."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from imitwalk.cli.robot_args import recorded_robot, robot_label
@@ -82,26 +81,12 @@ def check_resumed_robot(args: argparse.Namespace, rd: RunDir, robot: Robot) -> N
 
 
 def check_resumed_clip(rd: RunDir, clip: str) -> None:
-    """Refuse to resume the run in ``rd`` with another clip than it records (the same
-    file, or one of the same bytes, passes; a recorded path not found from here is
-    compared by its file name)."""
-    import filecmp
-
-    from imitwalk.errors import ConfigError
+    """Refuse to resume the run in ``rd`` with another clip than it records
+    (:func:`~imitwalk.runs.check_resumed_clip`), a stepping gait's or a reference's."""
+    from imitwalk.runs import check_resumed_clip as check
 
     _folder, cfg = _recorded(rd)
     ref = cfg.get("reference")
-    source = cfg.get("source") or (ref.get("source") if isinstance(ref, dict) else None)
-    if not isinstance(source, str) or not source:
-        return
-    was, now = Path(source), Path(clip)
-    if was.resolve() == now.resolve():
-        return
-    if was.is_file() and now.is_file() and filecmp.cmp(was, now, shallow=False):
-        return
-    if not was.exists() and was.name == now.name:
-        return
-    raise ConfigError(
-        f"{clip}: {rd.path} was started on the clip {source}; resume it without a clip "
-        "(or with that one), or learn this clip into a new folder"
+    check(
+        rd.path, cfg.get("source") or (ref.get("source") if isinstance(ref, dict) else None), clip
     )

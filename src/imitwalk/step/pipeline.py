@@ -29,7 +29,7 @@ import numpy as np
 from imitwalk.errors import ConfigError, MocapError, RunError
 from imitwalk.retarget.provenance import Provenance
 from imitwalk.robots import Robot
-from imitwalk.runs import LearnSummary, RunDir, StepOutcome
+from imitwalk.runs import LearnSummary, RunDir, StepOutcome, check_resumed_clip
 from imitwalk.step.gains import shipped_gains
 from imitwalk.step.gait import StepGait
 from imitwalk.step.learn import StepLearnConfig, learn_step
@@ -199,6 +199,7 @@ def learn(
     cfg = cfg or StepLearnConfig()
     protocol = load_protocol(cfg.protocol)
     if resume:
+        _check_resumed_clip(out, clip)
         gait = resumed_gait(out, backward)
     else:
         motion = clip if isinstance(clip, Motion) else load_clip(clip or default_clip(), robot)
@@ -211,6 +212,19 @@ def learn(
                 + _turning(st)
             )
     return learn_clip(gait, robot, cfg, out, protocol, resume=resume, progress=progress)
+
+
+def _check_resumed_clip(out: str | Path, clip: Motion | str | Path | None) -> None:
+    """Refuse to resume the run in ``out`` with another clip than it records
+    (:func:`~imitwalk.runs.check_resumed_clip`): a file's or a
+    :class:`~imitwalk.mocap.Motion`'s source (``None``: the run's own)."""
+    from imitwalk.mocap import Motion
+
+    if clip is None:
+        return
+    rd = RunDir(out)
+    source = rd.read_json("config.json").get("source") if rd.exists("config.json") else None
+    check_resumed_clip(rd.path, source, clip.source if isinstance(clip, Motion) else str(clip))
 
 
 def _turning(style: GaitStyle) -> str:
