@@ -32,7 +32,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -90,8 +90,6 @@ class PPOConfig:
     hidden: tuple[int, ...] = (256, 256)
     log_std_init: float | None = None
     snapshot_every: float = 2_000.0
-    critic_warmup: float = 0.0
-    target_kl: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.budget, int | float) or not np.isfinite(self.budget):
@@ -197,7 +195,6 @@ def train(
     every = max(int(round(cfg.snapshot_every / dt)), 1)
     steps = int(model.num_timesteps)
     checkpoint = _Checkpoints(rd, cfg.budget, dt, every, wall, progress, steps, steps // every)
-    checkpoint.warmup = int(round(cfg.critic_warmup / dt))
     _learn(model, venv, total, resume, checkpoint)
     return _finish(rd, walk, cfg, float(model.num_timesteps) * dt, wall)
 
@@ -237,7 +234,6 @@ def _model(rd: RunDir, venv: VecEnv, walk: WalkConfig, cfg: PPOConfig, resume: b
         gae_lambda=cfg.gae_lambda,
         clip_range=cfg.clip_range,
         ent_coef=cfg.ent_coef,
-        target_kl=cfg.target_kl,
         policy_kwargs={
             "net_arch": {"pi": hidden, "vf": hidden},
             "log_std_init": (
@@ -286,7 +282,6 @@ class _Checkpoints:
     progress: Callable[[str], None] | None
     saved: int
     snapshots: int
-    warmup: int = 0
 
     def __call__(self, m: PPO) -> None:
         """Save the model, its policy and a log line: after each update, so that the
@@ -342,17 +337,6 @@ def _checkpoint_callback(checkpoint: _Checkpoints) -> BaseCallback:
 
         def _on_rollout_start(self) -> None:  # the last rollout's update is done
             checkpoint(self.model)  # type: ignore[arg-type]  # SB3 says BaseAlgorithm: this PPO
-
-        def _on_rollout_end(self) -> None:  # the update comes next
-            pol: Any = self.model.policy  # SB3's ActorCriticPolicy
-            actor = [
-                *pol.mlp_extractor.policy_net.parameters(),
-                *pol.action_net.parameters(),
-                pol.log_std,
-            ]
-            frozen = self.model.num_timesteps <= checkpoint.warmup
-            for p in actor:
-                p.requires_grad_(not frozen)
 
     return Checkpoint()
 
