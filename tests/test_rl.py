@@ -151,9 +151,13 @@ def test_the_actor_commands_what_the_environment_commands(residual_run):
 
 
 def test_resume_continues_and_refuses_other_settings(tmp_path, capsys):
+    import torch
+
     out = tmp_path / "run"
     args = ["rl", "--out", str(out), "--protocol", "eval", *TINY]
+    threads = torch.get_num_threads()
     assert _cli(args, capsys)[0] == 0
+    assert torch.get_num_threads() == threads  # trained on one thread, the caller's restored
     first = (out / "log.jsonl").read_text().splitlines()
     code, _, err = _cli(args, capsys)
     assert code == 2 and "already holds a run" in err

@@ -38,7 +38,7 @@ from imitwalk.errors import (
     SensorError,
 )
 
-__version__ = "0.12.0"
+__version__ = "0.12.1"
 
 #: The flat API: name -> the module that defines it, or (module, its name there); each is
 #: imported on first use.

@@ -191,11 +191,18 @@ def train(
     venv = SubprocVecEnv(makers) if cfg.envs > 1 else DummyVecEnv(makers)
     venv.seed(cfg.seed)
     torch.manual_seed(cfg.seed)
-    model = _model(rd, venv, walk, cfg, resume)
-    every = max(int(round(cfg.snapshot_every / dt)), 1)
-    steps = int(model.num_timesteps)
-    checkpoint = _Checkpoints(rd, cfg.budget, dt, every, wall, progress, steps, steps // every)
-    _learn(model, venv, total, resume, checkpoint)
+    # one thread for the network: its batches are small, and a second thread's waiting
+    # takes the core an environment's process needs (PPO 1.3 x faster on 2 cores)
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        model = _model(rd, venv, walk, cfg, resume)
+        every = max(int(round(cfg.snapshot_every / dt)), 1)
+        steps = int(model.num_timesteps)
+        checkpoint = _Checkpoints(rd, cfg.budget, dt, every, wall, progress, steps, steps // every)
+        _learn(model, venv, total, resume, checkpoint)
+    finally:
+        torch.set_num_threads(threads)
     return _finish(rd, walk, cfg, float(model.num_timesteps) * dt, wall)
 
 
