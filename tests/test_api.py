@@ -52,7 +52,10 @@ def _first_row() -> tuple[int, int]:
 @pytest.mark.slow
 def test_the_readmes_python_example_reproduces_its_first_row(tmp_path):
     """The library example learns the default clip and judges it on eval's 40 robots: the
-    falls and the learning's simulated seconds it prints are the table's first row."""
+    falls it prints are the table's first row, and the learning's simulated seconds too,
+    within 10 %: a run repeats to the bit on one machine, not across processors (their
+    vector code rounds differently, and the search takes another path: 1,082 s on an
+    AVX-512 EPYC against the row's 1,008, as the README says)."""
     out = subprocess.run(
         [sys.executable, "-c", _readme_python()[0]],
         check=True,
@@ -63,7 +66,9 @@ def test_the_readmes_python_example_reproduces_its_first_row(tmp_path):
     falls, spent = re.fullmatch(
         r"(\d+) of 40 fell; learning walked ([\d,]+) simulated s\n", out
     ).groups()
-    assert (int(falls), int(spent.replace(",", ""))) == _first_row()
+    row_falls, row_spent = _first_row()
+    assert int(falls) == row_falls
+    assert int(spent.replace(",", "")) == pytest.approx(row_spent, rel=0.1)
 
 
 @pytest.mark.slow
