@@ -19,6 +19,7 @@ from imitwalk.cli.progress import emit, progress
 
 if TYPE_CHECKING:
     from imitwalk.runs import RunDir
+    from imitwalk.step.learn import StepLearnConfig
 
 __all__ = ["DEMO_LEARN", "demo", "run_demo"]
 
@@ -52,7 +53,7 @@ def run_demo(out: Path) -> dict:
     rd.check_writable()
     cfg = apply_overrides(StepLearnConfig(), DEMO_LEARN)
     if rd.exists("metrics.json"):
-        _check_demo_run(rd, cfg.to_dict(), robot.name)
+        _check_demo_run(rd, cfg, robot.name)
         progress(f"demo: {out} already holds a finished demo run; reusing it")
     else:
         resume = rd.exists("style.json")
@@ -88,21 +89,22 @@ def run_demo(out: Path) -> dict:
     return summary
 
 
-def _check_demo_run(rd: RunDir, learn: dict, robot: str) -> None:
-    """Refuse a finished run that is not the demo's own (``learn``: its settings, on
-    ``robot``): the demo would judge it as its own and overwrite its verdict.
+def _check_demo_run(rd: RunDir, cfg: StepLearnConfig, robot: str) -> None:
+    """Refuse a finished run that is not the demo's own (a stepping run of ``cfg`` on
+    ``robot``, :func:`~imitwalk.step.pipeline.started_otherwise`): the demo would judge it
+    as its own and overwrite its verdict.
 
     Raises:
         RunError: one line naming the folder.
     """
     from imitwalk.errors import RunError
+    from imitwalk.step.pipeline import started_otherwise
 
     try:
         config = rd.read_json("config.json")
     except RunError:
         config = {}
-    ours = config.get("learner") == "step" and config.get("learn") == learn
-    if not ours or config.get("robot") != robot:
+    if config.get("learner") != "step" or started_otherwise(config, cfg, robot) is not None:
         raise RunError(
             f"--out {rd.path} holds a run that is not the demo's (other settings, robot or "
             "files); nothing was changed: give a new folder, or the demo's own"

@@ -111,14 +111,9 @@ def learn_clip(
     if resume:
         if not rd.exists("style.json"):
             raise RunError(f"nothing to resume in {rd.path}: no style.json")
-        started = rd.read_json("config.json")
-        if started.get("learn") != cfg.to_dict():
-            raise RunError(f"{rd.path} was started with other settings; resume with the same ones")
-        if started.get("robot", robot.name) != robot.name:
-            raise RunError(
-                f"{rd.path} was started on robot {started['robot']!r}, not {robot.name!r}; "
-                "resume it on that robot, or learn into a new folder"
-            )
+        why = started_otherwise(rd.read_json("config.json"), cfg, robot.name)
+        if why is not None:
+            raise RunError(f"{rd.path} was started {why}")
         gait = StepGait.load(rd.file("style.json"))
     # the search starts from the shipped gains of the walk's direction
     start = shipped_gains(backward=gait.style.backward)
@@ -212,6 +207,20 @@ def learn(
                 + _turning(st)
             )
     return learn_clip(gait, robot, cfg, out, protocol, resume=resume, progress=progress)
+
+
+def started_otherwise(started: dict, cfg: StepLearnConfig, robot: str) -> str | None:
+    """How a stepping run whose ``config.json`` is ``started`` was not started with
+    ``cfg`` on ``robot`` (its name), in words that follow "was started"; ``None`` if it
+    was (a run that records no robot passes as any)."""
+    if started.get("learn") != cfg.to_dict():
+        return "with other settings; resume with the same ones"
+    if started.get("robot", robot) != robot:
+        return (
+            f"on robot {started['robot']!r}, not {robot!r}; resume it on that robot, or "
+            "learn into a new folder"
+        )
+    return None
 
 
 def _check_resumed_clip(out: str | Path, clip: Motion | str | Path | None) -> None:
